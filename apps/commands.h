@@ -1,0 +1,10 @@
+#pragma once
+// Each sub-command of the `lumigauss` tool lives in its own cmd_*.cpp and registers itself here.
+#include <CLI/CLI.hpp>
+
+namespace lumigauss::cli {
+
+void register_info(CLI::App& app);
+void register_render(CLI::App& app);
+
+}  // namespace lumigauss::cli

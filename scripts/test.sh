@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs dependencies, builds, and runs the test suite with CTest.
+#   scripts/test.sh            fast tier in a release build, then the fast tier under ASan/UBSan
+#   scripts/test.sh --all      also the slow tier (release build)
+#   scripts/test.sh --no-asan  skip the sanitizer build
+set -euo pipefail
+cd "$(dirname "$0")/.."
+all=0; asan=1
+for a in "$@"; do
+    case "$a" in
+        --all) all=1 ;;
+        --no-asan) asan=0 ;;
+        *) echo "test.sh: unknown option $a" >&2; exit 2 ;;
+    esac
+done
+jobs=$(nproc)
+
+scripts/setup.sh --no-build
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DLUMIGAUSS_WERROR=ON ${LUMIGAUSS_CMAKE_ARGS:-}
+cmake --build build -j "$jobs"
+labels="fast"
+[ $all -eq 1 ] && labels="fast|slow"
+status=0
+(cd build && ctest --output-on-failure -j "$jobs" -L "$labels") || status=1
+
+if [ $asan -eq 1 ]; then
+    cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLUMIGAUSS_WERROR=ON -DLUMIGAUSS_SANITIZE=ON \
+          -DLUMIGAUSS_BUILD_BENCH=OFF ${LUMIGAUSS_CMAKE_ARGS:-}
+    cmake --build build-asan -j "$jobs"
+    (cd build-asan && ctest --output-on-failure -j "$jobs" -L fast) || status=1
+fi
+exit $status
