@@ -38,42 +38,68 @@ using Vec4f = Vec4<float>;
 using Vec3d = Vec3<double>;
 
 template <typename T>
-LG_HD constexpr Vec2<T> operator+(Vec2<T> a, Vec2<T> b) { return {a.x + b.x, a.y + b.y}; }
+LG_HD constexpr Vec2<T> operator+(Vec2<T> a, Vec2<T> b) {
+    return {a.x + b.x, a.y + b.y};
+}
 template <typename T>
-LG_HD constexpr Vec2<T> operator-(Vec2<T> a, Vec2<T> b) { return {a.x - b.x, a.y - b.y}; }
+LG_HD constexpr Vec2<T> operator-(Vec2<T> a, Vec2<T> b) {
+    return {a.x - b.x, a.y - b.y};
+}
 template <typename T>
-LG_HD constexpr Vec2<T> operator*(T s, Vec2<T> a) { return {s * a.x, s * a.y}; }
+LG_HD constexpr Vec2<T> operator*(T s, Vec2<T> a) {
+    return {s * a.x, s * a.y};
+}
 
 template <typename T>
-LG_HD constexpr Vec3<T> operator+(Vec3<T> a, Vec3<T> b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+LG_HD constexpr Vec3<T> operator+(Vec3<T> a, Vec3<T> b) {
+    return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
 template <typename T>
-LG_HD constexpr Vec3<T> operator-(Vec3<T> a, Vec3<T> b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+LG_HD constexpr Vec3<T> operator-(Vec3<T> a, Vec3<T> b) {
+    return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
 template <typename T>
-LG_HD constexpr Vec3<T> operator-(Vec3<T> a) { return {-a.x, -a.y, -a.z}; }
+LG_HD constexpr Vec3<T> operator-(Vec3<T> a) {
+    return {-a.x, -a.y, -a.z};
+}
 template <typename T>
-LG_HD constexpr Vec3<T> operator*(T s, Vec3<T> a) { return {s * a.x, s * a.y, s * a.z}; }
+LG_HD constexpr Vec3<T> operator*(T s, Vec3<T> a) {
+    return {s * a.x, s * a.y, s * a.z};
+}
 template <typename T>
-LG_HD constexpr Vec3<T> operator*(Vec3<T> a, T s) { return {s * a.x, s * a.y, s * a.z}; }
+LG_HD constexpr Vec3<T> operator*(Vec3<T> a, T s) {
+    return {s * a.x, s * a.y, s * a.z};
+}
 template <typename T>
-LG_HD constexpr Vec3<T> operator/(Vec3<T> a, T s) { return {a.x / s, a.y / s, a.z / s}; }
+LG_HD constexpr Vec3<T> operator/(Vec3<T> a, T s) {
+    return {a.x / s, a.y / s, a.z / s};
+}
 template <typename T>
 LG_HD constexpr Vec3<T>& operator+=(Vec3<T>& a, Vec3<T> b) {
     a.x += b.x, a.y += b.y, a.z += b.z;
     return a;
 }
 template <typename T>
-LG_HD constexpr Vec3<T> hadamard(Vec3<T> a, Vec3<T> b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+LG_HD constexpr Vec3<T> hadamard(Vec3<T> a, Vec3<T> b) {
+    return {a.x * b.x, a.y * b.y, a.z * b.z};
+}
 
 template <typename T>
-LG_HD constexpr T dot(Vec3<T> a, Vec3<T> b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+LG_HD constexpr T dot(Vec3<T> a, Vec3<T> b) {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 template <typename T>
 LG_HD constexpr Vec3<T> cross(Vec3<T> a, Vec3<T> b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 template <typename T>
-LG_HD inline T length(Vec3<T> a) { return std::sqrt(dot(a, a)); }
+LG_HD inline T length(Vec3<T> a) {
+    return std::sqrt(dot(a, a));
+}
 template <typename T>
-LG_HD inline Vec3<T> normalize(Vec3<T> a) { return a / length(a); }
+LG_HD inline Vec3<T> normalize(Vec3<T> a) {
+    return a / length(a);
+}
 
 // Row-major 3x3 matrix: m[r] is row r.
 template <typename T>
@@ -107,7 +133,8 @@ template <typename T>
 LG_HD constexpr Mat3<T> operator*(const Mat3<T>& a, const Mat3<T>& b) {
     Mat3<T> r;
     for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[i][0] * b.m[0][j] + a.m[i][1] * b.m[1][j] + a.m[i][2] * b.m[2][j];
+        for (int j = 0; j < 3; ++j)
+            r.m[i][j] = a.m[i][0] * b.m[0][j] + a.m[i][1] * b.m[1][j] + a.m[i][2] * b.m[2][j];
     return r;
 }
 

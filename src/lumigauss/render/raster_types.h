@@ -1,0 +1,95 @@
+#pragma once
+// Inputs and outputs of the surfel rasterizer (any backend), as structures of arrays.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "lumigauss/io/camera.h"
+#include "lumigauss/render/surfel_projection.h"
+
+namespace lumigauss {
+
+// Activated surfel parameters for one render: linear scales, opacity in [0, 1], any number of colour
+// channels (3 for RGB; 6 when shadowed and unshadowed shading are rendered in one pass).
+template <typename T>
+struct SurfelBatch {
+    int channels = 3;
+    std::vector<T> means;      // 3 per surfel
+    std::vector<T> quats;      // 4 per surfel, w x y z, not necessarily normalised
+    std::vector<T> scales;     // 2 per surfel: s_u, s_v
+    std::vector<T> opacities;  // 1 per surfel
+    std::vector<T> colors;     // `channels` per surfel
+
+    std::size_t size() const { return opacities.size(); }
+    void resize(std::size_t n) {
+        means.resize(3 * n), quats.resize(4 * n), scales.resize(2 * n), opacities.resize(n);
+        colors.resize(std::size_t(channels) * n);
+    }
+    raster::SurfelGeometry<T> geometry(std::size_t i) const {
+        return {{means[3 * i], means[3 * i + 1], means[3 * i + 2]},
+                {quats[4 * i], quats[4 * i + 1], quats[4 * i + 2], quats[4 * i + 3]},
+                scales[2 * i],
+                scales[2 * i + 1]};
+    }
+};
+
+// Every map the rasterizer writes, row-major, `width * height` pixels.
+template <typename T>
+struct RasterImages {
+    int width = 0, height = 0, channels = 0;
+    std::vector<T> color;         // `channels` per pixel, background included
+    std::vector<T> alpha;         // 1 - final transmittance
+    std::vector<T> depth;         // sum of w_i z_i (divide by alpha for the expected depth)
+    std::vector<T> median_depth;  // depth where the transmittance crosses 0.5
+    std::vector<T> normal;        // 3 per pixel: sum of w_i n_i, world space, camera-facing
+    std::vector<T> distortion;    // sum_{j<i} w_i w_j (m_i - m_j)^2 on mapped depth m
+};
+
+// dL/d(map) for each map; an empty vector means zero.
+template <typename T>
+using RasterImageGrads = RasterImages<T>;
+
+template <typename T>
+struct SurfelGrads {
+    std::vector<T> means, quats, scales, opacities, colors;
+    std::vector<T> mean2d;  // 2 per surfel: dL/d(screen translation of the projected centre), pixels
+};
+
+template <typename T>
+struct RasterSettings {
+    std::vector<T> background;  // `channels` values; empty = black
+};
+
+// What the forward keeps for the backward.
+template <typename T>
+struct RasterState {
+    raster::PinholeView<T> view{};
+    int tiles_x = 0, tiles_y = 0;
+    std::vector<raster::ProjectedSurfel<T>> projected;
+    std::vector<std::uint8_t> visible;
+    std::vector<std::uint32_t> emission_offset;  // per surfel: first (surfel, tile) emission; size N + 1
+    std::vector<std::uint32_t> tile_start;       // per tile: first sorted entry; size tiles + 1
+    std::vector<std::uint32_t> entry_surfel;     // sorted entries: surfel id (per tile, front to back)
+    std::vector<std::uint32_t> emission_entry;   // emission -> sorted entry
+    std::vector<T> final_transmittance;          // per pixel
+    std::vector<std::uint32_t> contributors;     // per pixel: entries up to the last composited, in its tile
+    std::vector<std::int32_t> median_entry;      // per pixel: sorted entry giving the median depth, or -1
+    std::vector<T> m1, m2;                       // per pixel: sum w m, sum w m^2 (distortion)
+    std::vector<T> background;
+
+    std::size_t intersections() const { return entry_surfel.size(); }
+};
+
+template <typename T>
+raster::PinholeView<T> pinhole_view(const Camera& camera) {
+    return {camera.rotation.cast<T>(),
+            camera.translation.cast<T>(),
+            T(camera.fx),
+            T(camera.fy),
+            T(camera.cx),
+            T(camera.cy),
+            camera.width,
+            camera.height};
+}
+
+}  // namespace lumigauss

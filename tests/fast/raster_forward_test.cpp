@@ -1,0 +1,289 @@
+// The tiled CPU rasterizer against the dense brute-force reference, plus the edge cases.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "support/random_surfels.h"
+#include "support/raster_reference.h"
+
+namespace lumigauss {
+namespace {
+
+using testing::convert_batch;
+using testing::random_surfels;
+using testing::RandomSceneOptions;
+using testing::reference_render;
+using testing::test_camera;
+
+template <typename T>
+RasterImages<T> render(const Camera& cam, const SurfelBatch<T>& s, std::vector<T> bg = {}) {
+    RasterState<T> st;
+    RasterSettings<T> settings;
+    settings.background = std::move(bg);
+    return rasterize_forward_cpu(cam, s, settings, st);
+}
+
+template <typename A, typename B>
+double max_abs_diff(const std::vector<A>& a, const std::vector<B>& b) {
+    EXPECT_EQ(a.size(), b.size());
+    double m = 0;
+    for (std::size_t i = 0; i < a.size() && i < b.size(); ++i)
+        m = std::max(m, std::abs(double(a[i]) - double(b[i])));
+    return m;
+}
+
+template <typename T>
+void expect_matches_reference(const RasterImages<T>& got, const RasterImages<double>& ref, double tol) {
+    EXPECT_LE(max_abs_diff(got.color, ref.color), tol) << "color";
+    EXPECT_LE(max_abs_diff(got.alpha, ref.alpha), tol) << "alpha";
+    EXPECT_LE(max_abs_diff(got.depth, ref.depth), tol * 10) << "depth";  // depths are ~5, relative 1e-5
+    EXPECT_LE(max_abs_diff(got.median_depth, ref.median_depth), tol * 10) << "median depth";
+    EXPECT_LE(max_abs_diff(got.normal, ref.normal), tol) << "normal";
+    EXPECT_LE(max_abs_diff(got.distortion, ref.distortion), tol) << "distortion";
+}
+
+bool all_finite(const RasterImages<float>& img) {
+    for (const auto* v :
+         {&img.color, &img.alpha, &img.depth, &img.median_depth, &img.normal, &img.distortion})
+        for (float x : *v)
+            if (!std::isfinite(x)) return false;
+    return true;
+}
+
+TEST(RasterForward, TiledMatchesDenseReferenceDouble) {
+    const Camera cam = test_camera(53, 41);  // not a multiple of the tile size
+    for (std::uint32_t seed = 1; seed <= 5; ++seed) {
+        RandomSceneOptions o;
+        o.count = 60;
+        const auto s = random_surfels<double>(cam, seed, o);
+        const auto ref = reference_render(cam, s, {0.2, 0.4, 0.1});
+        expect_matches_reference(render(cam, s, {0.2, 0.4, 0.1}), ref, 1e-12);
+    }
+}
+
+TEST(RasterForward, FloatTiledMatchesDenseReferenceTo1e5) {
+    const Camera cam = test_camera(64, 48);
+    for (std::uint32_t seed = 11; seed <= 15; ++seed) {
+        RandomSceneOptions o;
+        o.count = 80;
+        // The reference sees exactly the float inputs, so only the arithmetic differs.
+        const auto s = convert_batch<float>(random_surfels<double>(cam, seed, o));
+        const auto ref = reference_render(cam, convert_batch<double>(s));
+        expect_matches_reference(render(cam, s), ref, 1e-5);
+    }
+}
+
+TEST(RasterForward, SixChannelsRenderLikeTwoThreeChannelPasses) {
+    const Camera cam = test_camera();
+    RandomSceneOptions o;
+    o.channels = 6;
+    const auto s6 = random_surfels<double>(cam, 3, o);
+    SurfelBatch<double> a = s6, b = s6;
+    a.channels = b.channels = 3;
+    a.colors.assign(s6.size() * 3, 0), b.colors.assign(s6.size() * 3, 0);
+    for (std::size_t i = 0; i < s6.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            a.colors[i * 3 + c] = s6.colors[i * 6 + c], b.colors[i * 3 + c] = s6.colors[i * 6 + 3 + c];
+    const auto i6 = render(cam, s6), ia = render(cam, a), ib = render(cam, b);
+    for (std::size_t p = 0; p < i6.alpha.size(); ++p)
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_DOUBLE_EQ(i6.color[p * 6 + c], ia.color[p * 3 + c]);
+            EXPECT_DOUBLE_EQ(i6.color[p * 6 + 3 + c], ib.color[p * 3 + c]);
+        }
+}
+
+TEST(RasterForward, EmptySceneIsBackground) {
+    const Camera cam = test_camera();
+    SurfelBatch<float> s;
+    const auto img = render(cam, s, {0.25f, 0.5f, 1.0f});
+    for (std::size_t p = 0; p < img.alpha.size(); ++p) {
+        EXPECT_EQ(img.alpha[p], 0.0f);
+        EXPECT_EQ(img.color[p * 3 + 2], 1.0f);
+    }
+}
+
+// A single surfel facing the camera, `z` metres in front of it, in camera space.
+SurfelBatch<double> one_surfel(const Camera& cam, Vec3d p_cam, double scale, double opacity,
+                               Vec4<double> quat = {1, 0, 0, 0}) {
+    SurfelBatch<double> s;
+    s.resize(1);
+    const Vec3d w = transpose(cam.rotation) * (p_cam - cam.translation);
+    // Express the camera-space orientation `quat` in world space.
+    const Mat3d R = transpose(cam.rotation) * rotation_from_unit_quaternion(normalize_quaternion(quat));
+    const Vec4<double> qw = quaternion_from_rotation(R);
+    for (int k = 0; k < 3; ++k) s.means[k] = w[k];
+    for (int k = 0; k < 4; ++k) s.quats[k] = qw[k];
+    s.scales = {scale, scale};
+    s.opacities = {opacity};
+    s.colors = {1, 0.5, 0.25};
+    return s;
+}
+
+TEST(RasterForward, SurfelBehindCameraOrBeforeNearPlaneIsInvisible) {
+    const Camera cam = test_camera();
+    for (double z : {-3.0, 0.0, 0.1, 0.2}) {
+        const auto img = render(cam, one_surfel(cam, {0, 0, z}, 0.5, 0.9));
+        EXPECT_EQ(*std::max_element(img.alpha.begin(), img.alpha.end()), 0.0) << "z=" << z;
+    }
+    const auto img = render(cam, one_surfel(cam, {0, 0, 0.25}, 0.01, 0.9));
+    EXPECT_GT(*std::max_element(img.alpha.begin(), img.alpha.end()), 0.0);
+}
+
+TEST(RasterForward, CentredSurfelPeaksAtItsProjection) {
+    const Camera cam = test_camera();
+    const auto img = render(cam, one_surfel(cam, {0, 0, 3}, 0.3, 0.8));
+    // Centre pixel: the projected mean lies at (cx, cy).
+    const int x = int(cam.cx), y = int(cam.cy);
+    const double a = img.alpha[std::size_t(y) * cam.width + x];
+    EXPECT_NEAR(a, 0.8, 0.05);
+    EXPECT_NEAR(img.depth[std::size_t(y) * cam.width + x] / a, 3.0, 1e-6);
+    EXPECT_NEAR(img.median_depth[std::size_t(y) * cam.width + x], 3.0, 1e-6);
+    // Camera-facing normal (world space) points towards the camera.
+    const Vec3d n{img.normal[3 * (std::size_t(y) * cam.width + x)],
+                  img.normal[3 * (std::size_t(y) * cam.width + x) + 1],
+                  img.normal[3 * (std::size_t(y) * cam.width + x) + 2]};
+    const Vec3d n_cam = cam.rotation * (n / a);
+    EXPECT_NEAR(n_cam.z, -1.0, 1e-9);
+}
+
+TEST(RasterForward, EdgeOnSurfelsStayFinite) {
+    const Camera cam = test_camera();
+    // Rotated 90 degrees about the camera's y axis: the disk is seen exactly edge-on at the centre.
+    const double h = std::sqrt(0.5);
+    for (Vec4<double> q :
+         {Vec4<double>{h, 0, h, 0}, Vec4<double>{h, h, 0, 0}, Vec4<double>{0.7072, 0, 0.7070, 0}}) {
+        auto s = one_surfel(cam, {0, 0, 3}, 0.5, 0.9, q);
+        const auto img = render(cam, convert_batch<float>(s));
+        EXPECT_TRUE(all_finite(img));
+        expect_matches_reference(render(cam, s), reference_render(cam, s), 1e-12);
+    }
+}
+
+TEST(RasterForward, PartlyOffScreenMatchesReference) {
+    const Camera cam = test_camera();
+    SurfelBatch<double> s = one_surfel(cam, {-1.9, 1.4, 3}, 0.6, 0.9);
+    expect_matches_reference(render(cam, s), reference_render(cam, s), 1e-12);
+    s = one_surfel(cam, {-2.5, 0, 3}, 0.6, 0.9);  // centre off-screen, its disk reaches into the image
+    const auto img = render(cam, s);
+    EXPECT_GT(*std::max_element(img.alpha.begin(), img.alpha.end()), 0.0);
+    expect_matches_reference(img, reference_render(cam, s), 1e-12);
+}
+
+TEST(RasterForward, HugeSurfelCrossingTheCameraPlaneHasNoGarbageBox) {
+    const Camera cam = test_camera();
+    // A 20 m disk, 1 m in front, tilted so that its 3-sigma disk reaches behind the camera.
+    const double c = std::cos(0.6), sn = std::sin(0.6);
+    auto s = one_surfel(cam, {0, 0, 1.0}, 20.0, 0.7, {c, sn, 0, 0});
+    const auto proj_ok = [&] {
+        raster::ProjectedSurfel<double> p;
+        const bool ok = raster::project_surfel(s.geometry(0), pinhole_view<double>(cam), p);
+        EXPECT_TRUE(ok);
+        EXPECT_FALSE(p.conic_center);  // took the crossing path
+        EXPECT_EQ(p.rect.x0, 0);
+        EXPECT_EQ(p.rect.x1, cam.width - 1);
+        return ok;
+    }();
+    ASSERT_TRUE(proj_ok);
+    const auto img = render(cam, s);
+    // Every pixel whose ray meets the disk's plane in front of the near plane sees it; the others do not.
+    const Vec3d mean_cam{0, 0, 1.0};
+    const Vec3d n_cam = rotation_from_unit_quaternion(normalize_quaternion(Vec4<double>{c, sn, 0, 0})).col(2);
+    int seen = 0;
+    for (int y = 0; y < cam.height; ++y)
+        for (int x = 0; x < cam.width; ++x) {
+            const Vec3d ray{(x + 0.5 - cam.cx) / cam.fx, (y + 0.5 - cam.cy) / cam.fy, 1.0};
+            const double z_hit = dot(mean_cam, n_cam) / dot(ray, n_cam);  // ray parameter = depth
+            const double a = img.alpha[std::size_t(y) * cam.width + x];
+            if (z_hit > 0.25 && z_hit < 5) {
+                EXPECT_GT(a, 0.5) << x << "," << y;
+            }
+            if (z_hit < 0.15) {
+                EXPECT_EQ(a, 0.0) << x << "," << y;
+            }
+            seen += a > 0.5;
+        }
+    EXPECT_GT(seen, cam.width * cam.height / 4);
+    expect_matches_reference(img, reference_render(cam, s), 1e-12);
+    EXPECT_TRUE(all_finite(render(cam, convert_batch<float>(s))));
+}
+
+TEST(RasterForward, TinySurfelIsKeptVisibleByTheLowPassFilter) {
+    const Camera cam = test_camera();
+    const auto s = one_surfel(cam, {0.01, 0.02, 3}, 1e-6, 0.9);
+    const auto img = render(cam, s);
+    const double peak = *std::max_element(img.alpha.begin(), img.alpha.end());
+    EXPECT_GT(peak, 0.3);  // about one pixel wide, from the screen filter
+    expect_matches_reference(img, reference_render(cam, s), 1e-12);
+}
+
+TEST(RasterForward, ZeroOpacityContributesNothing) {
+    const Camera cam = test_camera();
+    const auto img = render(cam, one_surfel(cam, {0, 0, 3}, 0.5, 0.0));
+    EXPECT_EQ(*std::max_element(img.alpha.begin(), img.alpha.end()), 0.0);
+}
+
+TEST(RasterForward, OpaqueStackStopsAtTransmittanceThreshold) {
+    const Camera cam = test_camera();
+    SurfelBatch<double> s;
+    for (int i = 0; i < 8; ++i) {
+        auto one = one_surfel(cam, {0, 0, 2.0 + 0.3 * i}, 2.0, 1.0);
+        s.means.insert(s.means.end(), one.means.begin(), one.means.end());
+        s.quats.insert(s.quats.end(), one.quats.begin(), one.quats.end());
+        s.scales.insert(s.scales.end(), one.scales.begin(), one.scales.end());
+        s.opacities.push_back(1.0);
+        s.colors.insert(s.colors.end(), {double(i), 0, 0});
+    }
+    const auto img = render(cam, s);
+    const std::size_t centre = std::size_t(cam.cy) * cam.width + std::size_t(cam.cx);
+    // Two layers at the alpha clamp 0.99 leave T = 1e-4 exactly at the threshold; the third would go below.
+    EXPECT_NEAR(img.alpha[centre], 1 - 1e-4, 1e-9);
+    expect_matches_reference(img, reference_render(cam, s), 1e-12);
+}
+
+TEST(RasterProjection, IntersectionReprojectsToThePixel) {
+    const Camera cam = test_camera();
+    const auto s = random_surfels<double>(cam, 7);
+    const auto view = pinhole_view<double>(cam);
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        raster::ProjectedSurfel<double> p;
+        if (!raster::project_surfel(s.geometry(i), view, p)) continue;
+        raster::SplatSample<double> smp;
+        const raster::SplatGeometry<double> g{p.tu, p.tv, p.tw, p.center, 1.0};
+        const double px = 17.5, py = 9.5;
+        if (!raster::evaluate_splat(g, px, py, smp)) continue;
+        // The surface point at (u, v) projects back onto the pixel, at depth tw . (u, v, 1).
+        const auto geo = s.geometry(i);
+        const Mat3d R = rotation_from_unit_quaternion(normalize_quaternion(geo.quat));
+        const Vec3d P = geo.mean + (geo.scale_u * smp.u) * R.col(0) + (geo.scale_v * smp.v) * R.col(1);
+        const Vec3d pc = cam.world_to_camera(P);
+        EXPECT_NEAR(cam.fx * pc.x / pc.z + cam.cx, px, 1e-9);
+        EXPECT_NEAR(cam.fy * pc.y / pc.z + cam.cy, py, 1e-9);
+        EXPECT_NEAR(p.tw.x * smp.u + p.tw.y * smp.v + p.tw.z, pc.z, 1e-9);
+    }
+}
+
+TEST(RasterProjection, BoundingSquareContainsTheThreeSigmaDisk) {
+    const Camera cam = test_camera();
+    RandomSceneOptions o;
+    o.count = 50;
+    const auto s = random_surfels<double>(cam, 8, o);
+    const auto view = pinhole_view<double>(cam);
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        raster::ProjectedSurfel<double> p;
+        if (!raster::project_surfel(s.geometry(i), view, p) || !p.conic_center) continue;
+        const auto geo = s.geometry(i);
+        const Mat3d R = rotation_from_unit_quaternion(normalize_quaternion(geo.quat));
+        for (int k = 0; k < 360; ++k) {
+            const double a = k * M_PI / 180;
+            const Vec3d P = geo.mean + (3 * geo.scale_u * std::cos(a)) * R.col(0) +
+                            (3 * geo.scale_v * std::sin(a)) * R.col(1);
+            const Vec3d pc = cam.world_to_camera(P);
+            EXPECT_LE(std::abs(cam.fx * pc.x / pc.z + cam.cx - p.center.x), p.radius + 1e-6);
+            EXPECT_LE(std::abs(cam.fy * pc.y / pc.z + cam.cy - p.center.y), p.radius + 1e-6);
+        }
+    }
+}
+
+}  // namespace
+}  // namespace lumigauss
