@@ -249,7 +249,7 @@ TEST(RasterProjection, IntersectionReprojectsToThePixel) {
         raster::ProjectedSurfel<double> p;
         if (!raster::project_surfel(s.geometry(i), view, p)) continue;
         raster::SplatSample<double> smp;
-        const raster::SplatGeometry<double> g{p.tu, p.tv, p.tw, p.center, 1.0};
+        const auto g = raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, 1.0);
         const double px = 17.5, py = 9.5;
         if (!raster::evaluate_splat(g, px, py, smp)) continue;
         // The surface point at (u, v) projects back onto the pixel, at depth tw . (u, v, 1).

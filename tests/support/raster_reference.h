@@ -36,8 +36,8 @@ inline RasterImages<double> reference_render(const Camera& cam, const SurfelBatc
                 const PixelRect& r = proj[i].rect;
                 if (x < r.x0 || x > r.x1 || y < r.y0 || y > r.y1) continue;
                 SplatSample<double> smp;
-                const SplatGeometry<double> g{proj[i].tu, proj[i].tv, proj[i].tw, proj[i].center,
-                                              s.opacities[i]};
+                const SplatGeometry<double> g =
+                    make_splat_geometry(proj[i].tu, proj[i].tv, proj[i].tw, proj[i].center, s.opacities[i]);
                 if (!evaluate_splat(g, x + 0.5, y + 0.5, smp)) continue;
                 const double next = trans * (1 - smp.alpha);
                 if (next < kTransmittanceMin) break;

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "lumigauss/io/camera.h"
-#include "lumigauss/render/surfel_projection.h"
+#include "lumigauss/render/surfel_kernel.h"
 
 namespace lumigauss {
 
@@ -66,6 +66,7 @@ struct RasterState {
     raster::PinholeView<T> view{};
     int tiles_x = 0, tiles_y = 0;
     std::vector<raster::ProjectedSurfel<T>> projected;
+    std::vector<raster::SplatGeometry<T>> splats;  // per surfel: what the per-pixel kernel reads
     std::vector<std::uint8_t> visible;
     std::vector<std::uint32_t> emission_offset;  // per surfel: first (surfel, tile) emission; size N + 1
     std::vector<std::uint32_t> tile_start;       // per tile: first sorted entry; size tiles + 1

@@ -1,0 +1,114 @@
+// Rasterizer forward and backward on the CPU: time per call, pixel-surfel pairs per second, and the speed-up
+// from 1 to 2 threads. Run: build/bench/raster_bench [--benchmark_filter=...]
+#include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
+
+#include "bench_scene.h"
+#include "lumigauss/render/cpu/rasterizer_cpu.h"
+
+namespace lumigauss::bench {
+namespace {
+
+// Number of (pixel, surfel) pairs the per-pixel kernel evaluates: each entry's bounding square clipped to
+// its tile.
+template <typename T>
+double evaluated_pairs(const RasterState<T>& st) {
+    double pairs = 0;
+    for (int t = 0; t < st.tiles_x * st.tiles_y; ++t) {
+        const int tx = t % st.tiles_x, ty = t / st.tiles_x, ts = raster::kTileSize;
+        for (std::uint32_t e = st.tile_start[t]; e < st.tile_start[t + 1]; ++e) {
+            const raster::PixelRect& r = st.projected[st.entry_surfel[e]].rect;
+            const int w = std::min(r.x1, tx * ts + ts - 1) - std::max(r.x0, tx * ts) + 1;
+            const int h = std::min(r.y1, ty * ts + ts - 1) - std::max(r.y0, ty * ts) + 1;
+            pairs += double(w) * h;
+        }
+    }
+    return pairs;
+}
+
+struct Fixture {
+    Camera cam;
+    SurfelBatch<float> surfels;
+};
+
+const Fixture& fixture(int width, int height, int count) {
+    static std::map<std::tuple<int, int, int>, Fixture> cache;
+    auto& f = cache[{width, height, count}];
+    if (f.surfels.size() == 0) f = {bench_camera(width, height), bench_surfels(std::size_t(count))};
+    return f;
+}
+
+void set_counters(benchmark::State& state, const RasterState<float>& st, const RasterImages<float>& img) {
+    const double pairs = evaluated_pairs(st);
+    const double pixels = double(st.view.width) * st.view.height;
+    double alpha = 0;
+    for (float a : img.alpha) alpha += a;
+    state.counters["intersections"] = double(st.intersections());
+    state.counters["pairs_per_pixel"] = pairs / pixels;
+    state.counters["pairs_per_s"] = benchmark::Counter(pairs, benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["mean_alpha"] = alpha / pixels;
+}
+
+void BM_Forward(benchmark::State& state) {
+    const auto& f = fixture(int(state.range(0)), int(state.range(1)), int(state.range(2)));
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(3)));
+    RasterState<float> st;
+    RasterImages<float> img;
+    for (auto _ : state) {
+        img = rasterize_forward_cpu(f.cam, f.surfels, RasterSettings<float>{}, st);
+        benchmark::DoNotOptimize(img.color.data());
+    }
+    set_counters(state, st, img);
+}
+
+void BM_Backward(benchmark::State& state) {
+    const auto& f = fixture(int(state.range(0)), int(state.range(1)), int(state.range(2)));
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(3)));
+    RasterState<float> st;
+    const RasterImages<float> img = rasterize_forward_cpu(f.cam, f.surfels, RasterSettings<float>{}, st);
+    RasterImageGrads<float> g;  // a loss on colour, alpha, depth and normals
+    g.color.assign(img.color.size(), 0.01f);
+    g.alpha.assign(img.alpha.size(), 0.01f);
+    g.depth.assign(img.depth.size(), 0.001f);
+    g.normal.assign(img.normal.size(), 0.01f);
+    for (auto _ : state) {
+        auto grads = rasterize_backward_cpu(f.surfels, st, g);
+        benchmark::DoNotOptimize(grads.means.data());
+    }
+    set_counters(state, st, img);
+}
+
+void BM_ForwardBackward(benchmark::State& state) {
+    const auto& f = fixture(int(state.range(0)), int(state.range(1)), int(state.range(2)));
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(3)));
+    RasterState<float> st;
+    RasterImages<float> img;
+    RasterImageGrads<float> g;
+    for (auto _ : state) {
+        img = rasterize_forward_cpu(f.cam, f.surfels, RasterSettings<float>{}, st);
+        g.color.assign(img.color.size(), 0.01f);
+        g.alpha.assign(img.alpha.size(), 0.01f);
+        auto grads = rasterize_backward_cpu(f.surfels, st, g);
+        benchmark::DoNotOptimize(grads.means.data());
+    }
+    set_counters(state, st, img);
+}
+
+void sizes(benchmark::internal::Benchmark* b) {
+    for (int threads : {1, 2}) {
+        for (int n : {50'000, 200'000, 1'000'000}) {
+            b->Args({320, 240, n, threads});
+            b->Args({1280, 720, n, threads});
+        }
+    }
+    b->ArgNames({"w", "h", "surfels", "threads"})->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+
+BENCHMARK(BM_Forward)->Apply(sizes);
+BENCHMARK(BM_Backward)->Apply(sizes);
+BENCHMARK(BM_ForwardBackward)->Apply(sizes);
+
+}  // namespace
+}  // namespace lumigauss::bench
+
+BENCHMARK_MAIN();
