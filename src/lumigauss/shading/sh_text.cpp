@@ -1,0 +1,74 @@
+#include "lumigauss/shading/sh_text.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "lumigauss/io/atomic_file.h"
+#include "lumigauss/util/error.h"
+
+namespace lumigauss {
+namespace {
+
+// One token as a finite double, or an Error naming file and line.
+double parse_number(const std::string& token, const std::string& path, int line_no) {
+    // from_chars rejects a leading '+', which other writers may emit.
+    const char* first = token.data() + (token.front() == '+' ? 1 : 0);
+    const char* last = token.data() + token.size();
+    double value = 0;
+    const auto [end, ec] = std::from_chars(first, last, value);
+    const std::string where = "line " + std::to_string(line_no) + ": ";
+    if (ec != std::errc{} || end != last) fail_in_file(path, where + "'" + token + "' is not a number");
+    if (!std::isfinite(value)) fail_in_file(path, where + "'" + token + "' is not a finite number");
+    return value;
+}
+
+// The whitespace/comma separated tokens of a line, comments removed.
+std::vector<std::string> tokens_of(std::string line) {
+    if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
+    for (char& ch : line)
+        if (ch == ',') ch = ' ';
+    std::istringstream in(line);
+    std::vector<std::string> tokens;
+    for (std::string t; in >> t;) tokens.push_back(t);
+    return tokens;
+}
+
+}  // namespace
+
+ShCoeffs<double> read_sh_text(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) fail_in_file(path, "cannot open the SH file (expected 9 lines 'R G B')");
+    ShCoeffs<double> sh;
+    int rows = 0, line_no = 0;
+    for (std::string line; std::getline(in, line);) {
+        ++line_no;
+        const std::vector<std::string> tokens = tokens_of(line);
+        if (tokens.empty()) continue;
+        const std::string where = "line " + std::to_string(line_no) + ": ";
+        if (rows == kShCount) fail_in_file(path, where + "more than 9 coefficient lines (degree-2 SH has 9)");
+        if (tokens.size() != 3)
+            fail_in_file(path, where + "expected 3 numbers 'R G B', found " + std::to_string(tokens.size()));
+        for (int c = 0; c < 3; ++c) sh.c[rows][c] = parse_number(tokens[c], path, line_no);
+        ++rows;
+    }
+    if (in.bad()) fail_in_file(path, "read error");
+    if (rows != kShCount)
+        fail_in_file(path, "expected 9 coefficient lines 'R G B', found " + std::to_string(rows));
+    return sh;
+}
+
+void write_sh_text(const std::string& path, const ShCoeffs<double>& sh) {
+    std::string text;
+    char buf[96];
+    for (const Vec3d& v : sh.c) {
+        std::snprintf(buf, sizeof buf, "%.9g %.9g %.9g\n", v.x, v.y, v.z);
+        text += buf;
+    }
+    write_file_atomically(path, text);
+}
+
+}  // namespace lumigauss

@@ -1,0 +1,131 @@
+// SH text files (shading/sh_text.h): round trip, tolerated syntax, errors naming file and line.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include <unistd.h>
+
+#include "fast/sh_test_util.h"
+#include "lumigauss/shading/sh_text.h"
+#include "lumigauss/util/error.h"
+
+namespace lumigauss {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A per-test scratch directory, removed afterwards.
+class ShText : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = fs::temp_directory_path() /
+               ("lumigauss_sh_text_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    std::string write(const std::string& name, const std::string& content) const {
+        const fs::path p = dir_ / name;
+        std::ofstream(p) << content;
+        return p.string();
+    }
+
+    // Reading `content` fails with a message that names the file and contains `what`.
+    void expect_error(const std::string& content, const std::string& what) const {
+        const std::string path = write("bad_sh.txt", content);
+        try {
+            read_sh_text(path);
+            FAIL() << "expected an Error for:\n" << content;
+        } catch (const Error& e) {
+            const std::string msg = e.what();
+            EXPECT_NE(msg.find(path), std::string::npos) << msg;
+            EXPECT_NE(msg.find(what), std::string::npos) << msg;
+        }
+    }
+
+    fs::path dir_;
+};
+
+const std::string kNineLines = "1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 9\n";
+
+TEST_F(ShText, RoundTrip) {
+    std::mt19937_64 rng(40);
+    ShCoeffs<double> sh = sh_test::random_sh(rng);
+    sh.c[3].y = 1.0e-12;  // tiny and huge magnitudes survive %.9g
+    sh.c[5].z = -3.5e7;
+    const std::string path = (dir_ / "env_sh.txt").string();
+    write_sh_text(path, sh);
+    const ShCoeffs<double> back = read_sh_text(path);
+    for (int k = 0; k < kShCount; ++k)
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(back.c[k][c], sh.c[k][c], 1e-8 * std::fabs(sh.c[k][c]));
+    // Float coefficients round-trip exactly.
+    const ShCoeffs<double> as_float = sh.cast<float>().cast<double>();
+    write_sh_text(path, as_float);
+    const ShCoeffs<double> back_float = read_sh_text(path);
+    for (int k = 0; k < kShCount; ++k)
+        for (int c = 0; c < 3; ++c)
+            EXPECT_EQ(static_cast<float>(back_float.c[k][c]), static_cast<float>(as_float.c[k][c]));
+}
+
+TEST_F(ShText, ToleratesCommentsBlankLinesCommasAndSigns) {
+    const std::string path = write("ok.txt",
+                                   "# environment SH, radiance\n\n"
+                                   "1 2 3   # L00\n"
+                                   "  4\t5\t6\n"
+                                   "+7, -8, 9e-1\n"
+                                   "1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 9\n\n# end\n");
+    const ShCoeffs<double> sh = read_sh_text(path);
+    EXPECT_EQ(sh.c[0].x, 1.0);
+    EXPECT_EQ(sh.c[1].z, 6.0);
+    EXPECT_EQ(sh.c[2].x, 7.0);
+    EXPECT_EQ(sh.c[2].y, -8.0);
+    EXPECT_EQ(sh.c[2].z, 0.9);
+    EXPECT_EQ(sh.c[8].z, 9.0);
+}
+
+TEST_F(ShText, ReadsThePlazaFiles) {
+    const fs::path path = fs::path(LUMIGAUSS_SHARED_DIR) / "data" / "plaza_mini" / "env" / "sky00_sh.txt";
+    if (!fs::exists(path)) GTEST_SKIP() << "no " << path;
+    const ShCoeffs<double> sh = read_sh_text(path.string());
+    EXPECT_DOUBLE_EQ(sh.c[0].x, 1.80995925);
+    EXPECT_DOUBLE_EQ(sh.c[8].z, 1.86203899e-01);
+}
+
+TEST_F(ShText, MissingFileIsAnError) {
+    const std::string path = (dir_ / "nope.txt").string();
+    try {
+        read_sh_text(path);
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+}
+
+TEST_F(ShText, NonNumericIsAnErrorNamingTheLine) {
+    expect_error("1 2 3\n4 5 6\n\n7 x 9\n1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n", "line 4: 'x' is not a number");
+    expect_error("1 2 3\n4 5 6z\n7 8 9\n1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 9\n", "line 2: '6z'");
+}
+
+TEST_F(ShText, NonFiniteIsAnErrorNamingTheLine) {
+    expect_error("1 2 3\n4 5 6\n7 8 nan\n1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 9\n",
+                 "line 3: 'nan' is not a finite");
+    expect_error("1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 inf\n",
+                 "line 9: 'inf' is not a finite");
+    expect_error("1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 1e999\n", "line 9: '1e999'");
+}
+
+TEST_F(ShText, WrongCountsAreErrors) {
+    expect_error("1 2 3\n4 5\n7 8 9\n1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 9\n",
+                 "line 2: expected 3 numbers");
+    expect_error("1 2 3 4\n", "line 1: expected 3 numbers 'R G B', found 4");
+    expect_error("1 2 3\n4 5 6\n# only two\n", "expected 9 coefficient lines 'R G B', found 2");
+    expect_error("", "found 0");
+    expect_error(kNineLines + "\n# fine\n1 2 3\n", "line 12: more than 9 coefficient lines");
+}
+
+}  // namespace
+}  // namespace lumigauss
