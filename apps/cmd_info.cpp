@@ -1,0 +1,80 @@
+// `lumigauss info <scene> [-r N]`: what load_dataset sees in a scene folder, before any training.
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "commands.h"
+#include "lumigauss/io/dataset.h"
+#include "lumigauss/io/scene_extent.h"
+
+namespace lumigauss::cli {
+
+namespace {
+
+struct InfoOptions {
+    std::string scene;
+    int downscale = 1;
+};
+
+// "128x96 (20), 64x48 (3)": distinct values with how many views have each.
+std::string counted(const std::map<std::string, int>& counts) {
+    std::string out;
+    for (const auto& [value, n] : counts)
+        out += (out.empty() ? "" : ", ") + value + " (" + std::to_string(n) + ")";
+    return out.empty() ? "none" : out;
+}
+
+void print_views(const Dataset& d) {
+    std::printf("views:         %zu (train %zu, test %zu, validation %zu)\n", d.views.size(),
+                d.split(Split::Train).size(), d.split(Split::Test).size(), d.split(Split::Validation).size());
+    std::map<std::string, int> sizes, models;
+    int masks = 0;
+    for (const View& v : d.views) {
+        ++sizes[std::to_string(v.camera.width) + "x" + std::to_string(v.camera.height)];
+        ++models[v.camera_model];
+        masks += v.mask_path.empty() ? 0 : 1;
+    }
+    std::printf("downscale:     %d\nresolutions:   %s\n", d.downscale, counted(sizes).c_str());
+    std::printf("camera models: %s\n", counted(models).c_str());
+    std::printf("masks:         %d of %zu views\n", masks, d.views.size());
+}
+
+void print_extent(const Dataset& d) {
+    std::printf("points:        %zu\n", d.point_xyz.size());
+    const CameraExtent e = camera_extent(d.views);
+    std::printf("camera centre: mean (%.4g, %.4g, %.4g), extent %.4g (1.1 x max distance from the mean)\n",
+                e.center.x, e.center.y, e.center.z, e.radius);
+    const PointBounds b = point_bounds(d.point_xyz);
+    if (b.empty) {
+        std::printf("points bbox:   none (no SfM points)\n");
+        return;
+    }
+    std::printf("points bbox:   min (%.4g, %.4g, %.4g), max (%.4g, %.4g, %.4g)\n", double(b.min.x),
+                double(b.min.y), double(b.min.z), double(b.max.x), double(b.max.y), double(b.max.z));
+}
+
+void run_info(const InfoOptions& o) {
+    DatasetOptions options;
+    options.downscale = o.downscale;
+    const Dataset d = load_dataset(o.scene, options);
+    std::printf("scene:         %s\nformat:        %s\n", d.root.c_str(), d.format.c_str());
+    print_views(d);
+    print_extent(d);
+}
+
+}  // namespace
+
+void register_info(CLI::App& app) {
+    auto options = std::make_shared<InfoOptions>();
+    CLI::App* cmd = app.add_subcommand("info",
+                                       "Describe a scene: views per split, resolutions, cameras, masks, "
+                                       "SfM points and extent");
+    cmd->add_option("scene", options->scene, "Scene folder (COLMAP sparse/0 + images/, or NeRF-OSR final/)")
+        ->required();
+    cmd->add_option("-r,--resolution", options->downscale, "Downscale images by 1, 2, 4 or 8")
+        ->check(CLI::IsMember({1, 2, 4, 8}));
+    cmd->callback([options] { run_info(*options); });
+}
+
+}  // namespace lumigauss::cli

@@ -1,0 +1,222 @@
+// COLMAP binary models: little-endian, uint64 record counts, then fixed-layout records (see colmap.h).
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <string>
+
+#include "lumigauss/io/atomic_file.h"
+#include "lumigauss/io/colmap.h"
+#include "lumigauss/io/colmap_detail.h"
+#include "lumigauss/util/error.h"
+
+namespace lumigauss {
+
+// The files are little-endian and records are copied with memcpy.
+static_assert(std::endian::native == std::endian::little, "COLMAP binary I/O assumes a little-endian host");
+
+namespace {
+
+using colmap_detail::join;
+
+// A bounds-checked cursor over a whole file that knows which record it is in, for error messages.
+class Reader {
+  public:
+    explicit Reader(std::string path)
+        : path_(std::move(path)), data_(colmap_detail::read_whole_file(path_)) {}
+
+    template <typename T>
+    T get() {
+        need(sizeof(T));
+        T value;
+        std::memcpy(&value, data_.data() + pos_, sizeof(T));
+        pos_ += sizeof(T);
+        return value;
+    }
+
+    void skip(std::uint64_t bytes) {
+        need(bytes);
+        pos_ += bytes;
+    }
+
+    std::string get_cstring() {
+        const std::size_t end = data_.find('\0', pos_);
+        if (end == std::string::npos) fail("truncated: the file ends inside the image name");
+        std::string s = data_.substr(pos_, end - pos_);
+        pos_ = end + 1;
+        return s;
+    }
+
+    // The record count at the start of the file. Each record takes at least `min_bytes`, so a count the file
+    // cannot hold is caught before anything is allocated for it.
+    std::uint64_t count(std::uint64_t min_bytes, const char* kind) {
+        kind_ = kind;
+        const auto n = get<std::uint64_t>();
+        if (n > remaining() / min_bytes)
+            fail("truncated: promises " + std::to_string(n) + " " + kind +
+                 " records but the file can hold at most " + std::to_string(remaining() / min_bytes));
+        count_ = n;
+        return n;
+    }
+
+    void begin_record(std::uint64_t index) {
+        in_header_ = false;
+        record_ = index;
+    }
+
+    void expect_end() const {
+        if (pos_ != data_.size())
+            fail_in_file(path_,
+                         std::to_string(data_.size() - pos_) + " unexpected bytes after the last record");
+    }
+
+    std::string where() const {
+        if (in_header_) return "record count";
+        return "record " + std::to_string(record_ + 1) + " of " + std::to_string(count_) + " (" + kind_ + ")";
+    }
+
+    [[noreturn]] void fail(const std::string& what) const { fail_in_file(path_, where() + ": " + what); }
+
+  private:
+    std::uint64_t remaining() const { return data_.size() - pos_; }
+    void need(std::uint64_t bytes) const {
+        if (remaining() < bytes) fail("truncated: the file ends inside this record");
+    }
+
+    std::string path_;
+    std::string data_;
+    std::size_t pos_ = 0;
+    const char* kind_ = "";
+    bool in_header_ = true;
+    std::uint64_t count_ = 0, record_ = 0;
+};
+
+std::map<int, ColmapCamera> read_cameras(const std::string& path) {
+    Reader in(path);
+    std::map<int, ColmapCamera> cameras;
+    const std::uint64_t n = in.count(4 + 4 + 8 + 8, "camera");
+    for (std::uint64_t i = 0; i < n; ++i) {
+        in.begin_record(i);
+        ColmapCamera cam;
+        cam.id = in.get<std::int32_t>();
+        const int model_id = in.get<std::int32_t>();
+        cam.model = colmap_model_name(model_id);
+        if (cam.model.empty()) in.fail("unknown camera model id " + std::to_string(model_id));
+        cam.width = int(in.get<std::uint64_t>());
+        cam.height = int(in.get<std::uint64_t>());
+        cam.params.resize(std::size_t(colmap_model_num_params(cam.model)));
+        for (double& p : cam.params) p = in.get<double>();
+        colmap_detail::check_camera(cam, path, in.where());
+        if (!cameras.emplace(cam.id, cam).second)
+            in.fail("camera_id " + std::to_string(cam.id) + " repeated");
+    }
+    in.expect_end();
+    return cameras;
+}
+
+std::vector<ColmapImage> read_images(const std::string& path, const std::map<int, ColmapCamera>& cameras) {
+    Reader in(path);
+    std::vector<ColmapImage> images;
+    const std::uint64_t n = in.count(4 + 7 * 8 + 4 + 1 + 8, "image");
+    for (std::uint64_t i = 0; i < n; ++i) {
+        in.begin_record(i);
+        ColmapImage im;
+        im.id = int(in.get<std::uint32_t>());
+        for (int k = 0; k < 4; ++k) im.qvec[k] = in.get<double>();
+        for (int k = 0; k < 3; ++k) im.tvec[k] = in.get<double>();
+        im.camera_id = int(in.get<std::uint32_t>());
+        im.name = in.get_cstring();
+        const auto num_points2d = in.get<std::uint64_t>();
+        // Each observation is x, y (double) and point3D_id (int64); guard the multiplication against
+        // overflow.
+        if (num_points2d > (std::uint64_t(1) << 40)) in.fail("implausible number of 2D points");
+        in.skip(num_points2d * 24);
+        colmap_detail::check_image(im, cameras, path, in.where());
+        images.push_back(std::move(im));
+    }
+    in.expect_end();
+    return images;
+}
+
+void read_points(const std::string& path, ColmapModel& model) {
+    Reader in(path);
+    const std::uint64_t n = in.count(8 + 3 * 8 + 3 + 8 + 8, "point");
+    model.point_xyz.reserve(n);
+    model.point_rgb.reserve(n);
+    for (std::uint64_t i = 0; i < n; ++i) {
+        in.begin_record(i);
+        in.get<std::uint64_t>();  // point id
+        Vec3f xyz, rgb;
+        for (int k = 0; k < 3; ++k) xyz[k] = float(in.get<double>());
+        for (int k = 0; k < 3; ++k) rgb[k] = float(in.get<std::uint8_t>()) / 255.0f;
+        in.get<double>();  // reprojection error
+        const auto track_length = in.get<std::uint64_t>();
+        if (track_length > (std::uint64_t(1) << 40)) in.fail("implausible track length");
+        in.skip(track_length * 8);  // (image_id, point2D_idx) as two uint32
+        if (!std::isfinite(xyz.x) || !std::isfinite(xyz.y) || !std::isfinite(xyz.z))
+            in.fail("point position has a NaN or Inf value");
+        model.point_xyz.push_back(xyz);
+        model.point_rgb.push_back(rgb);
+    }
+    in.expect_end();
+}
+
+template <typename T>
+void put(std::string& out, T value) {
+    char bytes[sizeof(T)];
+    std::memcpy(bytes, &value, sizeof(T));
+    out.append(bytes, sizeof(T));
+}
+
+std::uint8_t to_byte(float c) {
+    return std::uint8_t(std::lround(std::fmin(std::fmax(c, 0.0f), 1.0f) * 255.0f));
+}
+
+}  // namespace
+
+ColmapModel read_colmap_binary(const std::string& dir) {
+    ColmapModel model;
+    model.cameras = read_cameras(join(dir, "cameras.bin"));
+    model.images = read_images(join(dir, "images.bin"), model.cameras);
+    read_points(join(dir, "points3D.bin"), model);
+    return model;
+}
+
+void write_colmap_binary(const std::string& dir, const ColmapModel& model) {
+    std::filesystem::create_directories(dir);
+    std::string cams, ims, pts;
+    put<std::uint64_t>(cams, model.cameras.size());
+    for (const auto& [id, c] : model.cameras) {
+        const int model_id = colmap_model_id(c.model);
+        if (model_id < 0) fail_in_file(join(dir, "cameras.bin"), "unknown camera model '" + c.model + "'");
+        put<std::int32_t>(cams, id);
+        put<std::int32_t>(cams, model_id);
+        put<std::uint64_t>(cams, std::uint64_t(c.width));
+        put<std::uint64_t>(cams, std::uint64_t(c.height));
+        for (double p : c.params) put<double>(cams, p);
+    }
+    put<std::uint64_t>(ims, model.images.size());
+    for (const ColmapImage& im : model.images) {
+        put<std::uint32_t>(ims, std::uint32_t(im.id));
+        for (int k = 0; k < 4; ++k) put<double>(ims, im.qvec[k]);
+        for (int k = 0; k < 3; ++k) put<double>(ims, im.tvec[k]);
+        put<std::uint32_t>(ims, std::uint32_t(im.camera_id));
+        ims.append(im.name.c_str(), im.name.size() + 1);
+        put<std::uint64_t>(ims, 0);  // no 2D observations
+    }
+    put<std::uint64_t>(pts, model.point_xyz.size());
+    for (std::size_t i = 0; i < model.point_xyz.size(); ++i) {
+        put<std::uint64_t>(pts, i + 1);
+        for (int k = 0; k < 3; ++k) put<double>(pts, model.point_xyz[i][k]);
+        const Vec3f rgb = i < model.point_rgb.size() ? model.point_rgb[i] : Vec3f{};
+        for (int k = 0; k < 3; ++k) put<std::uint8_t>(pts, to_byte(rgb[k]));
+        put<double>(pts, 0.0);       // reprojection error
+        put<std::uint64_t>(pts, 0);  // empty track
+    }
+    write_file_atomically(join(dir, "cameras.bin"), cams);
+    write_file_atomically(join(dir, "images.bin"), ims);
+    write_file_atomically(join(dir, "points3D.bin"), pts);
+}
+
+}  // namespace lumigauss

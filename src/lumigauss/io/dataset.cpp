@@ -1,0 +1,125 @@
+#include "lumigauss/io/dataset.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <set>
+
+#include "lumigauss/io/dataset_detail.h"
+#include "lumigauss/util/error.h"
+
+namespace lumigauss {
+
+namespace {
+
+using dataset_detail::RawView;
+
+std::string size_text(int w, int h) {
+    return std::to_string(w) + "x" + std::to_string(h);
+}
+
+// Header-only checks: the image is readable and as large as its camera says; the mask as large as the image.
+void check_files(const RawView& raw) {
+    const View& v = raw.view;
+    const ImageInfo image = read_image_info(v.image_path);
+    if (image.width != v.camera.width || image.height != v.camera.height)
+        fail_in_file(v.image_path, "image is " + size_text(image.width, image.height) + " but its camera (" +
+                                       raw.camera_origin + ") is " +
+                                       size_text(v.camera.width, v.camera.height));
+    if (v.mask_path.empty()) return;
+    const ImageInfo mask = read_image_info(v.mask_path);
+    if (mask.width != image.width || mask.height != image.height)
+        fail_in_file(v.mask_path, "mask is " + size_text(mask.width, mask.height) + " but its image " +
+                                      v.image_path + " is " + size_text(image.width, image.height));
+}
+
+void check_unique_names(const std::vector<RawView>& views) {
+    std::set<std::string> seen;
+    for (const RawView& r : views)
+        if (!seen.insert(r.view.name).second)
+            fail_in_file(r.view.image_path, "two views are named " + r.view.name + " (names must be unique)");
+}
+
+// Full-resolution file size must match the camera before anything is downscaled.
+View finish_view(const RawView& raw, int factor) {
+    check_files(raw);
+    View v = raw.view;
+    v.source_width = v.camera.width;
+    v.source_height = v.camera.height;
+    v.camera =
+        v.camera.resized(downscaled_size(v.camera.width, factor), downscaled_size(v.camera.height, factor));
+    return v;
+}
+
+// The loaded image at the view's resolution, after checking that the file has the size its header had.
+Image fit_to_view(Image image, const View& view, const std::string& path, const char* kind) {
+    if (image.width != view.source_width || image.height != view.source_height)
+        fail_in_file(path, std::string(kind) + " is " + size_text(image.width, image.height) + " but " +
+                               view.name + " needs " + size_text(view.source_width, view.source_height));
+    if (image.width == view.camera.width && image.height == view.camera.height) return image;
+    return resize_area(image, view.camera.width, view.camera.height);
+}
+
+}  // namespace
+
+const char* split_name(Split split) {
+    switch (split) {
+        case Split::Train:
+            return "train";
+        case Split::Test:
+            return "test";
+        case Split::Validation:
+            return "validation";
+    }
+    return "?";
+}
+
+int downscaled_size(int size, int factor) {
+    return std::max(1, size / factor);
+}
+
+Image Dataset::load_image(const View& view) const {
+    return fit_to_view(to_channels(read_image(view.image_path), 3), view, view.image_path, "image");
+}
+
+Image Dataset::load_mask(const View& view) const {
+    if (view.mask_path.empty()) return Image(view.camera.width, view.camera.height, 1, 1.0f);
+    return fit_to_view(to_channels(read_image(view.mask_path), 1), view, view.mask_path, "mask");
+}
+
+std::vector<const View*> Dataset::split(Split which) const {
+    std::vector<const View*> out;
+    for (const View& v : views)
+        if (v.split == which) out.push_back(&v);
+    return out;
+}
+
+Dataset load_dataset(const std::string& root, const DatasetOptions& options) {
+    const int f = options.downscale;
+    if (f != 1 && f != 2 && f != 4 && f != 8)
+        throw Error("downscale factor must be 1, 2, 4 or 8, not " + std::to_string(f));
+    std::error_code ec;
+    if (!std::filesystem::is_directory(root, ec)) fail_in_file(root, "scene folder not found");
+    dataset_detail::RawScene raw;
+    if (dataset_detail::is_colmap_layout(root))
+        raw = dataset_detail::load_colmap_layout(root, options);
+    else if (dataset_detail::is_nerfosr_layout(root))
+        raw = dataset_detail::load_nerfosr_layout(root);
+    else
+        fail_in_file(root,
+                     "not a scene: expected a COLMAP layout (sparse/0/ with cameras, images, points3D as "
+                     ".bin or .txt, and images/) or a NeRF-OSR layout (final/{train,validation,test}/rgb/)");
+    std::sort(raw.views.begin(), raw.views.end(),
+              [](const RawView& a, const RawView& b) { return a.view.name < b.view.name; });
+    check_unique_names(raw.views);
+    Dataset d;
+    d.root = root;
+    d.format = raw.format;
+    d.downscale = f;
+    d.point_xyz = std::move(raw.point_xyz);
+    d.point_rgb = std::move(raw.point_rgb);
+    d.views.reserve(raw.views.size());
+    for (const RawView& r : raw.views) d.views.push_back(finish_view(r, f));
+    return d;
+}
+
+}  // namespace lumigauss

@@ -1,0 +1,67 @@
+#pragma once
+// A scene on disk as views (image path, optional mask path, undistorted pinhole camera, split) plus SfM
+// points. Two layouts are recognised (load_dataset sniffs which):
+//   COLMAP:   <root>/sparse/0/ (or <root>/sparse/) with {cameras,images,points3D}.{bin,txt}, <root>/images/,
+//             optional <root>/masks/ (mask of images/a/b.jpg: masks/a/b.<any image extension> or
+//             masks/a/b.jpg.png, COLMAP's own naming), optional <root>/*split.csv (`filename;split`).
+//   NeRF-OSR: <root>/final/ (or <root> itself) with {train,validation,test}/{rgb,pose,intrinsics,mask}/.
+// Pixels are loaded lazily (load_image, load_mask); load_dataset only checks that every file is there and
+// that its header size matches its camera.
+//
+// Downscaling by a factor f: a W x H image becomes floor(W/f) x floor(H/f) (at least 1), by area averaging of
+// the whole source extent onto the whole target extent (resize_area), and the camera is Camera::resized to
+// that size, so intrinsics scale by floor(W/f)/W and floor(H/f)/H -- exactly 1/f when f divides the size.
+#include <string>
+#include <vector>
+
+#include "lumigauss/io/camera.h"
+#include "lumigauss/io/image.h"
+#include "lumigauss/math/vec.h"
+
+namespace lumigauss {
+
+struct DatasetOptions {
+    int downscale = 1;  // 1, 2, 4 or 8
+    // Without a split file every n-th image (sorted by name, the first included) is a test image; 0: none.
+    int holdout_every = 8;
+};
+
+enum class Split { Train, Test, Validation };
+
+const char* split_name(Split split);  // "train", "test", "validation"
+
+struct View {
+    std::string name;        // image name as the model gives it (relative to the images folder)
+    std::string image_path;  // full path
+    std::string mask_path;   // empty if the view has no mask
+    Camera camera;           // at the loaded (downscaled) resolution
+    // Where the pinhole came from: the COLMAP model name, or "NERF-OSR K" for NeRF-OSR.
+    std::string camera_model;
+    Split split = Split::Train;
+    int source_width = 0, source_height = 0;  // the image file's size, before downscaling
+};
+
+struct Dataset {
+    std::string root;
+    std::string format;                       // "colmap-binary", "colmap-text" or "nerf-osr"
+    std::vector<View> views;                  // sorted by name
+    std::vector<Vec3f> point_xyz, point_rgb;  // SfM points (rgb in 0..1); empty for NeRF-OSR
+    int downscale = 1;
+
+    // RGB in [0, 1] (gray is replicated, alpha dropped), resized by the downscale factor. Throws Error naming
+    // the file if it cannot be read or its size is not the camera's.
+    Image load_image(const View& view) const;
+    // One channel in [0, 1] (first channel of the file; 1 = use the pixel), resized like the image. All ones
+    // when the view has no mask. Throws Error naming the mask file if its size differs from the image's.
+    Image load_mask(const View& view) const;
+    std::vector<const View*> split(Split which) const;
+};
+
+// Loads the layout found at `root`; Error naming the file and what to do for anything missing or
+// inconsistent.
+Dataset load_dataset(const std::string& root, const DatasetOptions& options = {});
+
+// The size an image of `size` pixels has after downscaling by `factor` (see above).
+int downscaled_size(int size, int factor);
+
+}  // namespace lumigauss

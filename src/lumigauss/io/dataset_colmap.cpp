@@ -1,0 +1,166 @@
+// The COLMAP layout: sparse/0 (or sparse) + images/ [+ masks/] [+ *split.csv].
+#include <algorithm>
+#include <filesystem>
+
+#include "lumigauss/io/colmap.h"
+#include "lumigauss/io/dataset_detail.h"
+#include "lumigauss/io/split_file.h"
+#include "lumigauss/math/quaternion.h"
+#include "lumigauss/util/error.h"
+
+namespace lumigauss::dataset_detail {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// COLMAP writes its first reconstruction to sparse/0; some tools put the model straight into sparse/.
+std::string find_sparse_dir(const std::string& root) {
+    for (const char* sub : {"sparse/0", "sparse"}) {
+        const std::string dir = (fs::path(root) / sub).string();
+        if (find_colmap_format(dir)) return dir;
+    }
+    return {};
+}
+
+bool all_zero(const std::vector<double>& params, std::size_t first) {
+    return std::all_of(params.begin() + long(first), params.end(), [](double p) { return p == 0.0; });
+}
+
+[[noreturn]] void refuse_distorted(const ColmapCamera& c, const std::string& file, const std::string& why) {
+    fail_in_file(file, "camera_id " + std::to_string(c.id) + " uses the " + c.model + " model " + why +
+                           "; LumiGauss needs undistorted pinhole images. Run `colmap image_undistorter "
+                           "--image_path images --input_path sparse/0 --output_path undistorted` and use the "
+                           "`undistorted` folder as the scene");
+}
+
+// Intrinsics of a pinhole camera. Distortion models are accepted only when every distortion term is zero.
+Camera pinhole_camera(const ColmapCamera& c, const std::string& file) {
+    Camera cam;
+    cam.width = c.width, cam.height = c.height;
+    const auto& p = c.params;
+    const bool one_focal = c.model == "SIMPLE_PINHOLE" || c.model == "SIMPLE_RADIAL" || c.model == "RADIAL";
+    const bool two_focal = c.model == "PINHOLE" || c.model == "OPENCV" || c.model == "FULL_OPENCV";
+    if (one_focal) {
+        cam.fx = cam.fy = p[0], cam.cx = p[1], cam.cy = p[2];
+        if (!all_zero(p, 3)) refuse_distorted(c, file, "with non-zero distortion");
+    } else if (two_focal) {
+        cam.fx = p[0], cam.fy = p[1], cam.cx = p[2], cam.cy = p[3];
+        if (!all_zero(p, 4)) refuse_distorted(c, file, "with non-zero distortion");
+    } else {
+        refuse_distorted(c, file, "(a fisheye model)");
+    }
+    if (!(cam.fx > 0 && cam.fy > 0))
+        fail_in_file(file, "camera_id " + std::to_string(c.id) + ": focal length must be positive");
+    return cam;
+}
+
+Camera posed_camera(Camera cam, const ColmapImage& im) {
+    cam.rotation = rotation_from_unit_quaternion(normalize_quaternion(im.qvec));
+    cam.translation = im.tvec;
+    return cam;
+}
+
+// masks/a/b.<image extension>, or COLMAP's masks/a/b.jpg.png; "" if neither exists. `masks` maps a path
+// relative to the masks folder, without its extension, to the file (index_images_by_stem).
+std::string find_mask(const std::map<std::string, std::string>& masks, const std::string& name) {
+    const std::string without_ext = (fs::path(name).parent_path() / fs::path(name).stem()).generic_string();
+    for (const std::string& key : {without_ext, fs::path(name).generic_string()}) {
+        const auto it = masks.find(key);
+        if (it != masks.end()) return it->second;
+    }
+    return {};
+}
+
+// The one `*split.csv` at the root, or "".
+std::string find_split_file(const std::string& root) {
+    std::vector<std::string> found;
+    for (const auto& entry : fs::directory_iterator(root)) {
+        const std::string file = entry.path().filename().string();
+        if (entry.is_regular_file() && file.ends_with("split.csv")) found.push_back(entry.path().string());
+    }
+    if (found.size() > 1)
+        fail_in_file(root, "several split files (" + found[0] + ", " + found[1] + "); keep one");
+    return found.empty() ? std::string() : found[0];
+}
+
+// Split file if there is one (every image must be listed), else every holdout_every-th image by name is test.
+void assign_splits(std::vector<RawView>& views, const std::string& root, int holdout_every) {
+    std::sort(views.begin(), views.end(),
+              [](const RawView& a, const RawView& b) { return a.view.name < b.view.name; });
+    const std::string split_path = find_split_file(root);
+    if (split_path.empty()) {
+        for (std::size_t i = 0; i < views.size(); ++i)
+            views[i].view.split =
+                holdout_every > 0 && i % std::size_t(holdout_every) == 0 ? Split::Test : Split::Train;
+        return;
+    }
+    const auto splits = read_split_file(split_path);
+    for (RawView& r : views) {
+        auto it = splits.find(r.view.name);
+        if (it == splits.end()) it = splits.find(fs::path(r.view.name).filename().string());
+        if (it == splits.end())
+            fail_in_file(split_path, "image " + r.view.name + " is not listed (every image needs a split)");
+        r.view.split = it->second;
+    }
+}
+
+struct ColmapFiles {
+    std::string sparse, cameras_file, images_file, images_dir;
+    bool binary = false;
+};
+
+ColmapFiles colmap_files(const std::string& root) {
+    ColmapFiles f;
+    f.sparse = find_sparse_dir(root);
+    f.binary = *find_colmap_format(f.sparse) == ColmapFormat::Binary;
+    const std::string ext = f.binary ? ".bin" : ".txt";
+    f.cameras_file = (fs::path(f.sparse) / ("cameras" + ext)).string();
+    f.images_file = (fs::path(f.sparse) / ("images" + ext)).string();
+    f.images_dir = (fs::path(root) / "images").string();
+    return f;
+}
+
+// One view at full resolution, after checking that its image file exists.
+RawView colmap_view(const ColmapImage& im, const ColmapCamera& c, const ColmapFiles& files) {
+    RawView r;
+    r.view.name = im.name;
+    r.view.image_path = (fs::path(files.images_dir) / im.name).string();
+    std::error_code ec;
+    if (!fs::is_regular_file(r.view.image_path, ec))
+        fail_in_file(r.view.image_path, "image listed in " + files.images_file + " is missing");
+    r.view.camera = posed_camera(pinhole_camera(c, files.cameras_file), im);
+    r.view.camera_model = c.model;
+    r.camera_origin = files.cameras_file + " camera_id " + std::to_string(c.id);
+    return r;
+}
+
+}  // namespace
+
+bool is_colmap_layout(const std::string& root) {
+    return !find_sparse_dir(root).empty();
+}
+
+RawScene load_colmap_layout(const std::string& root, const DatasetOptions& options) {
+    const ColmapFiles files = colmap_files(root);
+    const ColmapModel model =
+        files.binary ? read_colmap_binary(files.sparse) : read_colmap_text(files.sparse);
+    std::error_code ec;
+    if (!fs::is_directory(files.images_dir, ec))
+        fail_in_file(files.images_dir,
+                     "images folder not found (a COLMAP scene has images/ next to sparse/)");
+    const auto masks = index_images_by_stem((fs::path(root) / "masks").string());
+    RawScene scene;
+    scene.format = files.binary ? "colmap-binary" : "colmap-text";
+    for (const ColmapImage& im : model.images) {
+        RawView r = colmap_view(im, model.cameras.at(im.camera_id), files);  // the reader checked the id
+        r.view.mask_path = find_mask(masks, im.name);
+        scene.views.push_back(std::move(r));
+    }
+    assign_splits(scene.views, root, options.holdout_every);
+    scene.point_xyz = model.point_xyz;
+    scene.point_rgb = model.point_rgb;
+    return scene;
+}
+
+}  // namespace lumigauss::dataset_detail
