@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/util/error.h"
 #include "support/random_surfels.h"
 #include "support/raster_reference.h"
 
@@ -72,6 +73,20 @@ TEST(RasterForward, FloatTiledMatchesDenseReferenceTo1e5) {
         const auto ref = reference_render(cam, convert_batch<double>(s));
         expect_matches_reference(render(cam, s), ref, 1e-5);
     }
+}
+
+TEST(RasterForward, AnyChannelCountMatchesReference) {
+    const Camera cam = test_camera(40, 30);
+    for (int channels : {1, 2, 4, 6, 16}) {
+        RandomSceneOptions o;
+        o.channels = channels;
+        o.count = 40;
+        const auto s = random_surfels<double>(cam, 90 + std::uint32_t(channels), o);
+        expect_matches_reference(render(cam, s), reference_render(cam, s), 1e-12);
+    }
+    RandomSceneOptions o;
+    o.channels = 17;
+    EXPECT_THROW(render(cam, random_surfels<double>(cam, 1, o)), Error);
 }
 
 TEST(RasterForward, SixChannelsRenderLikeTwoThreeChannelPasses) {
@@ -177,7 +192,7 @@ TEST(RasterForward, HugeSurfelCrossingTheCameraPlaneHasNoGarbageBox) {
     auto s = one_surfel(cam, {0, 0, 1.0}, 20.0, 0.7, {c, sn, 0, 0});
     const auto proj_ok = [&] {
         raster::ProjectedSurfel<double> p;
-        const bool ok = raster::project_surfel(s.geometry(0), pinhole_view<double>(cam), p);
+        const bool ok = raster::project_surfel(s.geometry(0), s.opacities[0], pinhole_view<double>(cam), p);
         EXPECT_TRUE(ok);
         EXPECT_FALSE(p.conic_center);  // took the crossing path
         EXPECT_EQ(p.rect.x0, 0);
@@ -247,7 +262,7 @@ TEST(RasterProjection, IntersectionReprojectsToThePixel) {
     const auto view = pinhole_view<double>(cam);
     for (std::size_t i = 0; i < s.size(); ++i) {
         raster::ProjectedSurfel<double> p;
-        if (!raster::project_surfel(s.geometry(i), view, p)) continue;
+        if (!raster::project_surfel(s.geometry(i), 1.0, view, p)) continue;
         raster::SplatSample<double> smp;
         const auto g = raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, 1.0);
         const double px = 17.5, py = 9.5;
@@ -263,26 +278,39 @@ TEST(RasterProjection, IntersectionReprojectsToThePixel) {
     }
 }
 
-TEST(RasterProjection, BoundingSquareContainsTheThreeSigmaDisk) {
-    const Camera cam = test_camera();
+TEST(RasterProjection, BoundingBoxHoldsEveryContributingPixel) {
+    // Brute force: every pixel where the kernel says the surfel contributes lies inside its box, for
+    // random surfels of every opacity, including ones whose box is clipped by the image border.
+    const Camera cam = test_camera(48, 40);
     RandomSceneOptions o;
-    o.count = 50;
+    o.count = 200;
+    o.min_opacity = 0.01, o.max_opacity = 1.0;
+    o.min_scale = 0.001, o.max_scale = 0.8;
     const auto s = random_surfels<double>(cam, 8, o);
     const auto view = pinhole_view<double>(cam);
+    int contributing = 0;
     for (std::size_t i = 0; i < s.size(); ++i) {
         raster::ProjectedSurfel<double> p;
-        if (!raster::project_surfel(s.geometry(i), view, p) || !p.conic_center) continue;
-        const auto geo = s.geometry(i);
-        const Mat3d R = rotation_from_unit_quaternion(normalize_quaternion(geo.quat));
-        for (int k = 0; k < 360; ++k) {
-            const double a = k * M_PI / 180;
-            const Vec3d P = geo.mean + (3 * geo.scale_u * std::cos(a)) * R.col(0) +
-                            (3 * geo.scale_v * std::sin(a)) * R.col(1);
-            const Vec3d pc = cam.world_to_camera(P);
-            EXPECT_LE(std::abs(cam.fx * pc.x / pc.z + cam.cx - p.center.x), p.radius + 1e-6);
-            EXPECT_LE(std::abs(cam.fy * pc.y / pc.z + cam.cy - p.center.y), p.radius + 1e-6);
-        }
+        if (!raster::project_surfel(s.geometry(i), s.opacities[i], view, p)) continue;
+        const auto g = raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, s.opacities[i]);
+        for (int y = 0; y < cam.height; ++y)
+            for (int x = 0; x < cam.width; ++x) {
+                raster::SplatSample<double> smp;
+                if (!raster::evaluate_splat(g, x + 0.5, y + 0.5, smp)) continue;
+                ++contributing;
+                EXPECT_TRUE(x >= p.rect.x0 && x <= p.rect.x1 && y >= p.rect.y0 && y <= p.rect.y1)
+                    << "surfel " << i << " pixel " << x << "," << y;
+            }
     }
+    EXPECT_GT(contributing, 1000);
+}
+
+TEST(RasterProjection, TooTransparentSurfelsAreCulled) {
+    const Camera cam = test_camera();
+    raster::ProjectedSurfel<double> p;
+    const auto s = one_surfel(cam, {0, 0, 3}, 0.5, 1.0);
+    EXPECT_TRUE(raster::project_surfel(s.geometry(0), 1.0 / 255 * 1.01, pinhole_view<double>(cam), p));
+    EXPECT_FALSE(raster::project_surfel(s.geometry(0), 1.0 / 255 * 0.99, pinhole_view<double>(cam), p));
 }
 
 }  // namespace

@@ -136,6 +136,17 @@ TEST(RasterGradient, SixChannelsAndDenseOverlap) {
     check_gradients(cam, random_surfels<double>(cam, 41, o), random_loss(cam, 6, 41, {}), {}, 2e-5);
 }
 
+TEST(RasterGradient, AnyChannelCountUsesTheGeneralPath) {
+    const Camera cam = test_camera(30, 20);
+    for (int channels : {1, 4}) {
+        RandomSceneOptions o;
+        o.channels = channels;
+        o.count = 8;
+        check_gradients(cam, random_surfels<double>(cam, 45, o), random_loss(cam, channels, 45, {}), {},
+                        2e-5);
+    }
+}
+
 TEST(RasterGradient, SurfelCrossingTheCameraPlane) {
     const Camera cam = test_camera(32, 24);
     RandomSceneOptions o;

@@ -19,7 +19,7 @@ inline RasterImages<double> reference_render(const Camera& cam, const SurfelBatc
     std::vector<ProjectedSurfel<double>> proj(s.size());
     std::vector<std::size_t> order;
     for (std::size_t i = 0; i < s.size(); ++i)
-        if (s.opacities[i] > 0 && project_surfel(s.geometry(i), view, proj[i])) order.push_back(i);
+        if (project_surfel(s.geometry(i), s.opacities[i], view, proj[i])) order.push_back(i);
     std::stable_sort(order.begin(), order.end(),
                      [&](auto a, auto b) { return proj[a].depth < proj[b].depth; });
 

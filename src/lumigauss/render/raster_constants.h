@@ -9,9 +9,7 @@ inline constexpr double kFarPlane = 100.0;  // only used by the distortion map's
 inline constexpr double kAlphaMax = 0.99;   // alpha clamp: keeps 1 - alpha away from 0 for the backward
 inline constexpr double kAlphaMin = 1.0 / 255;     // contributions below this are skipped
 inline constexpr double kTransmittanceMin = 1e-4;  // a pixel stops once T would fall below this
-inline constexpr double kSigmaCutoff = 3.0;        // bounding box covers the 3-sigma disk
+inline constexpr double kSigmaCutoff = 3.0;        // the filter is centred on the 3-sigma disk's box
 inline constexpr double kFilterInvSquare = 2.0;  // screen low-pass: exp(-2|x-c|^2 / 2), sigma = sqrt(2)/2 px
-// The bounding square is never smaller than the low-pass filter's 3-sigma footprint.
-inline constexpr double kMinRadius = 2.1213203435596424;  // 3 * sqrt(2) / 2
 
 }  // namespace lumigauss::raster

@@ -69,9 +69,7 @@ LG_HD inline SplatGeometry<T> make_splat_geometry(Vec3<T> tu, Vec3<T> tv, Vec3<T
     g.tw = tw;
     g.center = center;
     g.opacity = opacity;
-    const T ratio = opacity / T(kAlphaMin);
-    // A little slack: the exact test is on alpha below; this one only skips work.
-    g.rho_cutoff = ratio > T(1) ? T(2) * std::log(ratio) * T(1.0001) + T(1e-6) : T(-1);
+    g.rho_cutoff = reach_rho(opacity);
     return g;
 }
 
@@ -113,14 +111,6 @@ struct RowSamples {
     T z[kTileSize], u[kTileSize], v[kTileSize], gauss[kTileSize];
     T screen[kTileSize];   // 1 where the screen filter won
     T clamped[kTileSize];  // 1 where alpha hit kAlphaMax
-
-    LG_HD SplatSample<T> sample(int i) const {
-        SplatSample<T> s;
-        s.alpha = alpha[i], s.z = z[i], s.u = u[i], s.v = v[i], s.gauss = gauss[i];
-        s.screen_branch = screen[i] != T(0);
-        s.clamped = clamped[i] != T(0);
-        return s;
-    }
 };
 
 template <typename T>
@@ -150,32 +140,57 @@ struct SplatGrad {
     T opacity{};
 };
 
-// Backward of evaluate_splat: adds the gradients from dL/dalpha and dL/dz to the surfel's accumulators.
-// The alpha clamp is differentiated exactly (no gradient through a clamped alpha).
+// What one pixel contributes to the surfel's kernel gradients, given dL/dalpha and dL/dz for the pair.
+// Branch-free (both filter branches computed, one selected, and every value of the branch not taken
+// zeroed before it can become inf * 0), so that it vectorises over pixels.
+template <typename T>
+struct SplatGradTerms {
+    Vec3<T> g_p;   // dL/d(homogeneous hit p); dL/dpa = dx g_p, dL/dpb = dy g_p, dL/dpd = g_p
+    T dx, dy;      // pixel - filter centre
+    Vec3<T> g_tw;  // direct dependence through z
+    Vec2<T> g_center;
+    T g_opacity;
+};
+
+// The sample is passed field by field (not as SplatSample) so that vectorised callers need not assemble
+// structs with bool members per pixel.
+template <typename T>
+LG_HD inline SplatGradTerms<T> splat_grad_terms(const SplatGeometry<T>& g, T px, T py, T sample_u, T sample_v,
+                                                T gauss, bool screen_branch, bool clamped, T g_alpha, T g_z) {
+    SplatGradTerms<T> t;
+    // The alpha clamp is differentiated exactly: no gradient through a clamped alpha.
+    const T ga = clamped ? T(0) : g_alpha;
+    t.g_opacity = gauss * ga;
+    const T g_gauss = g.opacity * ga;
+    t.dx = px - g.center.x;
+    t.dy = py - g.center.y;
+    const bool obj = !screen_branch;
+    // Screen branch: gauss = exp(-|pix - c|^2), so d gauss / d c = 2 (pix - c) gauss; z = tw.z.
+    const T k2 = obj ? T(0) : T(kFilterInvSquare) * gauss * g_gauss;
+    t.g_center = {k2 * t.dx, k2 * t.dy};
+    // Object branch: gauss = exp(-(u^2 + v^2) / 2), z = tw . (u, v, 1), (u, v) = (p.x, p.y) / p.z.
+    const T u = obj ? sample_u : T(0), v = obj ? sample_v : T(0);
+    const T g_u = -u * gauss * g_gauss + (obj ? g_z * g.tw.x : T(0));
+    const T g_v = -v * gauss * g_gauss + (obj ? g_z * g.tw.y : T(0));
+    const T p_z = t.dx * g.pa.z + t.dy * g.pb.z + g.pd.z;
+    const T inv_pz = obj ? T(1) / p_z : T(0);
+    t.g_p = {g_u * inv_pz, g_v * inv_pz, -(g_u * u + g_v * v) * inv_pz};
+    t.g_tw = {g_z * u, g_z * v, g_z};
+    return t;
+}
+
+// Backward of evaluate_splat for one pixel: adds the gradients from dL/dalpha and dL/dz to `acc`.
 template <typename T>
 LG_HD inline void evaluate_splat_vjp(const SplatGeometry<T>& g, T px, T py, const SplatSample<T>& s,
                                      T g_alpha, T g_z, SplatGrad<T>& acc) {
-    if (s.clamped) g_alpha = T(0);
-    acc.opacity += s.gauss * g_alpha;
-    const T g_gauss = g.opacity * g_alpha;
-    if (s.screen_branch) {
-        // gauss = exp(-|c - pix|^2)  =>  d gauss / d c = -2 (c - pix) gauss
-        const T k2 = T(kFilterInvSquare) * s.gauss * g_gauss;
-        acc.center.x -= k2 * (g.center.x - px);
-        acc.center.y -= k2 * (g.center.y - py);
-        acc.tw.z += g_z;
-        return;
-    }
-    // gauss = exp(-(u^2 + v^2) / 2), z = tw . (u, v, 1), (u, v) = (p.x, p.y) / p.z
-    const T g_u = -s.u * s.gauss * g_gauss + g_z * g.tw.x;
-    const T g_v = -s.v * s.gauss * g_gauss + g_z * g.tw.y;
-    const T dx = px - g.center.x, dy = py - g.center.y;
-    const T inv_pz = T(1) / (dx * g.pa.z + dy * g.pb.z + g.pd.z);
-    const Vec3<T> g_p{g_u * inv_pz, g_v * inv_pz, -(g_u * s.u + g_v * s.v) * inv_pz};
-    acc.pa += dx * g_p;
-    acc.pb += dy * g_p;
-    acc.pd += g_p;
-    acc.tw += g_z * Vec3<T>{s.u, s.v, T(1)};
+    const SplatGradTerms<T> t =
+        splat_grad_terms(g, px, py, s.u, s.v, s.gauss, s.screen_branch, s.clamped, g_alpha, g_z);
+    acc.pa += t.dx * t.g_p;
+    acc.pb += t.dy * t.g_p;
+    acc.pd += t.g_p;
+    acc.tw += t.g_tw;
+    acc.center = acc.center + t.g_center;
+    acc.opacity += t.g_opacity;
 }
 
 // Converts accumulated kernel gradients to gradients on the ray-transform rows (pa = tv x tw, pb = tw x tu,

@@ -24,7 +24,7 @@ struct PinholeView {
     int width, height;
 };
 
-// Pixels a surfel may touch: its bounding square, clipped to the image (inclusive bounds).
+// Pixels a surfel may touch, clipped to the image (inclusive bounds).
 struct PixelRect {
     int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
     LG_HD constexpr bool empty() const { return x1 < x0 || y1 < y0; }
@@ -33,8 +33,7 @@ struct PixelRect {
 template <typename T>
 struct ProjectedSurfel {
     Vec3<T> tu, tv, tw;  // rows of the ray transform T
-    Vec2<T> center;      // centre of the bounding square and of the screen low-pass filter (pixels)
-    T radius;            // half side of the bounding square (pixels)
+    Vec2<T> center;      // centre of the screen low-pass filter (pixels)
     Vec3<T> normal;      // world-space unit normal, flipped to face the camera
     T flip;              // +1 or -1: the flip applied to t_w
     T depth;             // view-space z of the mean: the sort key
@@ -50,17 +49,14 @@ struct SurfelGeometry {
     T scale_u, scale_v;
 };
 
+// Pixels whose centres x + 0.5, y + 0.5 lie in [lo, hi] (per axis), clipped to the image.
 template <typename T>
-LG_HD inline PixelRect pixel_rect_of_square(Vec2<T> c, T r, int width, int height) {
-    // Pixel x is inside iff |x + 0.5 - c.x| <= r.
+LG_HD inline PixelRect pixel_rect(Vec2<T> lo, Vec2<T> hi, int width, int height) {
     PixelRect rect;
-    if (!(r < T(1e7))) {  // the whole image (also catches infinities)
-        rect = {0, 0, width - 1, height - 1};
-        return rect;
-    }
-    const T fx0 = std::ceil(c.x - r - T(0.5)), fx1 = std::floor(c.x + r - T(0.5));
-    const T fy0 = std::ceil(c.y - r - T(0.5)), fy1 = std::floor(c.y + r - T(0.5));
-    if (fx1 < 0 || fy1 < 0 || fx0 > T(width - 1) || fy0 > T(height - 1)) return rect;  // empty
+    const T fx0 = std::ceil(lo.x - T(0.5)), fx1 = std::floor(hi.x - T(0.5));
+    const T fy0 = std::ceil(lo.y - T(0.5)), fy1 = std::floor(hi.y - T(0.5));
+    if (!(fx1 >= 0 && fy1 >= 0 && fx0 <= T(width - 1) && fy0 <= T(height - 1)))
+        return rect;  // empty (or NaN)
     rect.x0 = fx0 < 0 ? 0 : int(fx0);
     rect.y0 = fy0 < 0 ? 0 : int(fy0);
     rect.x1 = fx1 > T(width - 1) ? width - 1 : int(fx1);
@@ -68,19 +64,54 @@ LG_HD inline PixelRect pixel_rect_of_square(Vec2<T> c, T r, int width, int heigh
     return rect;
 }
 
-// Centre of the image of the c-sigma circle from its dual conic C* = T diag(c², c², -1) Tᵀ; valid when
-// d = c²(tw.x² + tw.y²) - tw.z² < 0, i.e. the whole disk lies in front of the camera plane.
+// The image of the disk u² + v² <= c2 has the dual conic C* = T diag(c2, c2, -1) Tᵀ; its bounding box
+// follows from the tangent lines x = const and y = const. It is an ellipse, and the box valid, only when
+// d = c2 (tw.x² + tw.y²) - tw.z² < 0: the whole disk lies in front of the camera plane.
 template <typename T>
-LG_HD inline T conic_denominator(Vec3<T> tw) {
-    const T c2 = T(kSigmaCutoff * kSigmaCutoff);
+LG_HD inline T conic_denominator(Vec3<T> tw, T c2) {
     return c2 * (tw.x * tw.x + tw.y * tw.y) - tw.z * tw.z;
 }
 
-// Projects one surfel. Returns false when it cannot be seen (behind the near plane, exactly edge-on,
-// degenerate, or off-screen).
 template <typename T>
-LG_HD inline bool project_surfel(const SurfelGeometry<T>& g, const PinholeView<T>& view,
+struct ConicBox {
+    Vec2<T> center;
+    T half_x, half_y;
+};
+
+template <typename T>
+LG_HD inline ConicBox<T> conic_box(Vec3<T> tu, Vec3<T> tv, Vec3<T> tw, T c2, T d) {
+    const Vec3<T> f{c2 / d, c2 / d, T(-1) / d};
+    ConicBox<T> box;
+    box.center = {dot(f, hadamard(tu, tw)), dot(f, hadamard(tv, tw))};
+    const T ex = box.center.x * box.center.x - dot(f, hadamard(tu, tu));
+    const T ey = box.center.y * box.center.y - dot(f, hadamard(tv, tv));
+    box.half_x = std::sqrt(ex > T(0) ? ex : T(0));
+    box.half_y = std::sqrt(ey > T(0) ? ey : T(0));
+    return box;
+}
+
+// The largest rho = min(rho_object, rho_screen) at which a surfel of this opacity still reaches alpha
+// kAlphaMin: opacity * exp(-rho / 2) >= kAlphaMin. Negative when it never does. A hair of slack, so that
+// work skipped on this bound is never work the exact alpha test would keep.
+template <typename T>
+LG_HD inline T reach_rho(T opacity) {
+    const T ratio = opacity / T(kAlphaMin);
+    return ratio > T(1) ? T(2) * std::log(ratio) * T(1.0001) + T(1e-6) : T(-1);
+}
+
+// Projects one surfel. Returns false when it cannot be seen (behind the near plane, exactly edge-on,
+// too transparent to ever reach kAlphaMin, degenerate, or off-screen).
+//
+// Two things are bounded separately. The screen low-pass filter is centred on the 3-sigma dual-conic box
+// centre, as in the reference implementation. The pixels it may touch are bounded exactly: where
+// opacity * exp(-rho/2) >= kAlphaMin, i.e. inside the ellipse rho_object <= reach_rho(opacity) or the
+// filter disk rho_screen <= reach_rho(opacity). Nothing that reaches alpha 1/255 is cut off, so the image
+// does not depend on the tile size, and no pixel is visited that cannot contribute.
+template <typename T>
+LG_HD inline bool project_surfel(const SurfelGeometry<T>& g, T opacity, const PinholeView<T>& view,
                                  ProjectedSurfel<T>& out) {
+    const T reach = reach_rho(opacity);
+    if (!(reach > T(0))) return false;
     const Vec3<T> mean_cam = view.rotation * g.mean + view.translation;
     if (!(mean_cam.z > T(kNearPlane))) return false;
     const Mat3<T> R = rotation_from_unit_quaternion(normalize_quaternion(g.quat));
@@ -100,30 +131,33 @@ LG_HD inline bool project_surfel(const SurfelGeometry<T>& g, const PinholeView<T
     out.tw = {a.z, b.z, mean_cam.z};
     out.depth = mean_cam.z;
 
-    const T d = conic_denominator(out.tw);
-    if (d < 0) {
-        const T c2 = T(kSigmaCutoff * kSigmaCutoff);
-        const Vec3<T> f{c2 / d, c2 / d, T(-1) / d};
-        const Vec3<T> tutw = hadamard(out.tu, out.tw), tvtw = hadamard(out.tv, out.tw);
-        out.center = {dot(f, tutw), dot(f, tvtw)};
-        const T ex = out.center.x * out.center.x - dot(f, hadamard(out.tu, out.tu));
-        const T ey = out.center.y * out.center.y - dot(f, hadamard(out.tv, out.tv));
-        const T hx = std::sqrt(ex > T(1e-4) ? ex : T(1e-4));
-        const T hy = std::sqrt(ey > T(1e-4) ? ey : T(1e-4));
-        T r = hx > hy ? hx : hy;
-        r = r > T(kMinRadius) ? r : T(kMinRadius);
-        out.radius = std::ceil(r);
-        out.conic_center = true;
-    } else {
-        // The 3-sigma disk crosses the camera plane: its image is unbounded (a hyperbola), so the box is the
-        // whole image and the per-pixel near test removes what lies behind. The filter is centred on the
-        // projected mean, which is in front of the camera.
-        out.center = {out.tu.z / out.tw.z, out.tv.z / out.tw.z};
-        out.radius = std::numeric_limits<T>::infinity();
-        out.conic_center = false;
-    }
+    // Filter centre.
+    const T c2 = T(kSigmaCutoff * kSigmaCutoff);
+    const T d3 = conic_denominator(out.tw, c2);
+    out.conic_center = d3 < 0;
+    // When the 3-sigma disk crosses the camera plane its box is meaningless; the projected mean (in front of
+    // the camera) centres the filter instead.
+    out.center = out.conic_center ? conic_box(out.tu, out.tv, out.tw, c2, d3).center
+                                  : Vec2<T>{out.tu.z / out.tw.z, out.tv.z / out.tw.z};
     if (!(std::isfinite(out.center.x) && std::isfinite(out.center.y))) return false;
-    out.rect = pixel_rect_of_square(out.center, out.radius, view.width, view.height);
+
+    // Pixels it can reach.
+    const T d_reach = conic_denominator(out.tw, reach);
+    if (d_reach < 0) {
+        const ConicBox<T> box = conic_box(out.tu, out.tv, out.tw, reach, d_reach);
+        const T filter = std::sqrt(reach / T(kFilterInvSquare));  // rho_screen <= reach within this distance
+        const auto lo = [](T a_, T b_) { return a_ < b_ ? a_ : b_; };
+        const auto hi = [](T a_, T b_) { return a_ > b_ ? a_ : b_; };
+        out.rect = pixel_rect<T>({lo(box.center.x - box.half_x, out.center.x - filter),
+                                  lo(box.center.y - box.half_y, out.center.y - filter)},
+                                 {hi(box.center.x + box.half_x, out.center.x + filter),
+                                  hi(box.center.y + box.half_y, out.center.y + filter)},
+                                 view.width, view.height);
+    } else {
+        // The reachable part of the disk crosses the camera plane: its image is unbounded, so the whole image
+        // is visited and the per-pixel near test removes what lies behind.
+        out.rect = {0, 0, view.width - 1, view.height - 1};
+    }
     return !out.rect.empty();
 }
 
@@ -151,7 +185,7 @@ LG_HD inline SurfelGeometryGrad<T> project_surfel_vjp(const SurfelGeometry<T>& g
     if (p.conic_center) {
         const T c2 = T(kSigmaCutoff * kSigmaCutoff);
         const Vec3<T> t{c2, c2, T(-1)};
-        const T d = conic_denominator(p.tw);
+        const T d = conic_denominator(p.tw, c2);
         // center.x = sum t_k tu_k tw_k / d,   d = sum t_k tw_k^2.
         const T gx = grad.center.x, gy = grad.center.y;
         for (int k = 0; k < 3; ++k) {

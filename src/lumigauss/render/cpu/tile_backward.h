@@ -1,0 +1,207 @@
+#pragma once
+// Backward of one 16x16 tile (internal to the CPU backend): the tile's list walked back to front, each
+// surfel evaluated on whole tile rows, and backward_row's per-pixel work done in one branch-free loop over
+// the row's 16 pixels. Gradients of the surfel are summed per lane (which vectorises without reordering
+// float sums across lanes) and reduced once per surfel into its (surfel, tile) slot.
+#include <cstdint>
+
+#include "lumigauss/render/cpu/tile_forward.h"
+
+namespace lumigauss::cpu {
+
+// Layout of one (surfel, tile) gradient slot, in the kernel's variables (surfel_kernel.h).
+struct SlotLayout {
+    static constexpr int kPa = 0, kPb = 3, kPd = 6, kTw = 9, kCenter = 12, kNormal = 14, kOpacity = 17,
+                         kColor = 18;
+    static int stride(int channels) { return kColor + channels; }
+};
+
+// Per-pixel state of the back-to-front walk, and the pixel's incoming gradients (zero where a map has none).
+template <typename T, int C>
+struct TileBackwardState {
+    alignas(64) T trans[kTilePixels];  // transmittance behind the splat being processed (T_final at first)
+    alignas(64) T acc_color[C][kTilePixels];  // blends of the splats behind
+    alignas(64) T acc_normal[3][kTilePixels];
+    alignas(64) T acc_z[kTilePixels];
+    alignas(64) T acc_alpha[kTilePixels];
+    alignas(64) T acc_dist[kTilePixels];
+    alignas(64) T g_color[C][kTilePixels];
+    alignas(64) T g_normal[3][kTilePixels];
+    alignas(64) T g_depth[kTilePixels];
+    alignas(64) T g_alpha[kTilePixels];
+    alignas(64) T g_dist[kTilePixels];
+    alignas(64) T g_median[kTilePixels];
+    alignas(64) T bg_term[kTilePixels];  // T_final * (background . dL/dcolor)
+    alignas(64) T a_total[kTilePixels];  // 1 - T_final
+    alignas(64) T m1[kTilePixels];
+    alignas(64) T m2[kTilePixels];
+    alignas(64) std::int32_t contributors[kTilePixels];
+    alignas(64) std::int32_t median_entry[kTilePixels];
+};
+
+// One surfel's gradients, summed per lane of the tile row.
+template <typename T, int C>
+struct LaneGrads {
+    alignas(64) T pa[3][kTileSize], pb[3][kTileSize], pd[3][kTileSize], tw[3][kTileSize];
+    alignas(64) T center[2][kTileSize];
+    alignas(64) T opacity[kTileSize];
+    alignas(64) T normal[3][kTileSize];
+    alignas(64) T color[C][kTileSize];
+};
+
+template <typename T, int C>
+LG_ALWAYS_INLINE void backward_row(TileBackwardState<T, C>& s, LaneGrads<T, C>& lg, int row_offset,
+                                   const raster::RowSamples<T>& row, const raster::SplatGeometry<T>& geometry,
+                                   T px0, T py, const T* color, int channels, Vec3<T> normal,
+                                   std::int32_t entry, std::int32_t rank) {
+    const raster::SplatGeometry<T> g = geometry;
+    T col[C];
+    for (int c = 0; c < C; ++c) col[c] = c < channels ? color[c] : T(0);
+#pragma omp simd
+    for (int i = 0; i < kTileSize; ++i) {
+        const int p = row_offset + i;
+        // Only pairs the forward composited: inside the pixel's contributor range, alpha above threshold.
+        const T a = rank <= s.contributors[p] ? row.alpha[i] : T(0);
+        const T one_minus_a = T(1) - a;
+        const T t_before = s.trans[p] / one_minus_a;
+        const T w = a * t_before;
+
+        // dL/dalpha: this splat's value against the blend of those behind it, for every map.
+        T g_alpha_inner = 0;
+        for (int c = 0; c < C; ++c) {
+            lg.color[c][i] += w * s.g_color[c][p];
+            g_alpha_inner += (col[c] - s.acc_color[c][p]) * s.g_color[c][p];
+        }
+        for (int k = 0; k < 3; ++k) {
+            lg.normal[k][i] += w * s.g_normal[k][p];
+            g_alpha_inner += (normal[k] - s.acc_normal[k][p]) * s.g_normal[k][p];
+        }
+        const T z = a > T(0) ? row.z[i] : T(1);
+        const T m = raster::distortion_depth(z);
+        const T dist_w = (m * m * s.a_total[p] + s.m2[p] - T(2) * m * s.m1[p]) * s.g_dist[p];  // dL/dw
+        g_alpha_inner +=
+            (z - s.acc_z[p]) * s.g_depth[p] + (T(1) - s.acc_alpha[p]) * s.g_alpha[p] + dist_w - s.acc_dist[p];
+        const T g_a = a > T(0) ? t_before * g_alpha_inner - s.bg_term[p] / one_minus_a : T(0);
+        const T g_z =
+            w * s.g_depth[p] + (s.median_entry[p] == entry ? s.g_median[p] : T(0)) +
+            T(2) * w * (m * s.a_total[p] - s.m1[p]) * s.g_dist[p] * raster::distortion_depth_derivative(z);
+
+        const raster::SplatGradTerms<T> t = raster::splat_grad_terms(
+            g, px0 + T(i), py, row.u[i], row.v[i], row.gauss[i], row.screen[i] != T(0),
+            row.clamped[i] != T(0), g_a, a > T(0) ? g_z : T(0));
+        for (int k = 0; k < 3; ++k) {
+            lg.pa[k][i] += t.dx * t.g_p[k];
+            lg.pb[k][i] += t.dy * t.g_p[k];
+            lg.pd[k][i] += t.g_p[k];
+            lg.tw[k][i] += t.g_tw[k];
+        }
+        lg.center[0][i] += t.g_center.x;
+        lg.center[1][i] += t.g_center.y;
+        lg.opacity[i] += t.g_opacity;
+
+        // Fold this splat into the "behind" blends of the splat in front of it (a == 0 changes nothing).
+        for (int c = 0; c < C; ++c) s.acc_color[c][p] = a * col[c] + one_minus_a * s.acc_color[c][p];
+        for (int k = 0; k < 3; ++k) s.acc_normal[k][p] = a * normal[k] + one_minus_a * s.acc_normal[k][p];
+        s.acc_z[p] = a * z + one_minus_a * s.acc_z[p];
+        s.acc_alpha[p] = a + one_minus_a * s.acc_alpha[p];
+        s.acc_dist[p] = a * dist_w + one_minus_a * s.acc_dist[p];
+        s.trans[p] = t_before;
+    }
+}
+
+template <typename T>
+T grad_at(const std::vector<T>& g, std::size_t i) {
+    return g.empty() ? T(0) : g[i];
+}
+
+template <typename T, int C>
+LG_ALWAYS_INLINE void load_tile_backward_state(TileBackwardState<T, C>& s, const raster::PixelRect& tr,
+                                               int channels, const RasterState<T>& st,
+                                               const RasterImageGrads<T>& g, std::uint32_t& last_rank) {
+    std::fill_n(&s.acc_color[0][0], C * kTilePixels, T(0));
+    std::fill_n(&s.acc_normal[0][0], 3 * kTilePixels, T(0));
+    std::fill_n(&s.g_color[0][0], C * kTilePixels, T(0));
+    std::fill_n(&s.g_normal[0][0], 3 * kTilePixels, T(0));
+    for (T* a : {s.trans, s.acc_z, s.acc_alpha, s.acc_dist, s.g_depth, s.g_alpha, s.g_dist, s.g_median,
+                 s.bg_term, s.a_total, s.m1, s.m2})
+        std::fill_n(a, kTilePixels, T(0));
+    std::fill_n(s.contributors, kTilePixels, 0);
+    std::fill_n(s.median_entry, kTilePixels, -1);
+    last_rank = 0;
+    const int width = st.view.width;
+    for (int y = tr.y0; y <= tr.y1; ++y)
+        for (int x = tr.x0; x <= tr.x1; ++x) {
+            const std::size_t pix = std::size_t(y) * width + x;
+            const int p = (y - tr.y0) * kTileSize + (x - tr.x0);
+            s.trans[p] = st.final_transmittance[pix];
+            s.a_total[p] = T(1) - s.trans[p];
+            T dot_bg = 0;
+            for (int c = 0; c < channels; ++c) {
+                s.g_color[c][p] = grad_at(g.color, pix * channels + c);
+                dot_bg += (st.background.empty() ? T(0) : st.background[c]) * s.g_color[c][p];
+            }
+            s.bg_term[p] = s.trans[p] * dot_bg;
+            for (int k = 0; k < 3; ++k) s.g_normal[k][p] = grad_at(g.normal, pix * 3 + k);
+            s.g_depth[p] = grad_at(g.depth, pix);
+            s.g_alpha[p] = grad_at(g.alpha, pix);
+            s.g_dist[p] = grad_at(g.distortion, pix);
+            s.g_median[p] = grad_at(g.median_depth, pix);
+            s.m1[p] = st.m1[pix];
+            s.m2[p] = st.m2[pix];
+            s.contributors[p] = std::int32_t(st.contributors[pix]);
+            s.median_entry[p] = st.median_entry[pix];
+            last_rank = std::max(last_rank, st.contributors[pix]);
+        }
+}
+
+template <typename T, int C>
+LG_ALWAYS_INLINE void store_slot(const LaneGrads<T, C>& lg, int channels, T* slot) {
+    const auto lane_sum = [](const T* v) {
+        T sum = 0;
+        for (int i = 0; i < kTileSize; ++i) sum += v[i];
+        return sum;
+    };
+    for (int k = 0; k < 3; ++k) {
+        slot[SlotLayout::kPa + k] = lane_sum(lg.pa[k]);
+        slot[SlotLayout::kPb + k] = lane_sum(lg.pb[k]);
+        slot[SlotLayout::kPd + k] = lane_sum(lg.pd[k]);
+        slot[SlotLayout::kTw + k] = lane_sum(lg.tw[k]);
+        slot[SlotLayout::kNormal + k] = lane_sum(lg.normal[k]);
+    }
+    slot[SlotLayout::kCenter] = lane_sum(lg.center[0]);
+    slot[SlotLayout::kCenter + 1] = lane_sum(lg.center[1]);
+    slot[SlotLayout::kOpacity] = lane_sum(lg.opacity);
+    for (int c = 0; c < channels; ++c) slot[SlotLayout::kColor + c] = lane_sum(lg.color[c]);
+}
+
+template <typename T, int C>
+LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const SurfelBatch<T>& surfels,
+                                           const RasterState<T>& st, const RasterImageGrads<T>& g, T* slots) {
+    const int stride = SlotLayout::stride(channels);
+    const raster::PixelRect tr = tile_pixels(tile, st.tiles_x, st.view.width, st.view.height);
+    TileBackwardState<T, C> s;
+    std::uint32_t last_rank = 0;  // entries past the largest contributor count touch no pixel
+    load_tile_backward_state(s, tr, channels, st, g, last_rank);
+
+    raster::RowSamples<T> row;
+    LaneGrads<T, C> lg;
+    const std::uint32_t begin = st.tile_start[tile], end = st.tile_start[tile + 1];
+    for (std::uint32_t e = begin + last_rank; e < end; ++e)  // never visited: zero slots
+        std::fill_n(&slots[std::size_t(e) * stride], stride, T(0));
+    for (std::uint32_t e = begin + last_rank; e-- > begin;) {
+        const std::uint32_t id = st.entry_surfel[e];
+        const raster::ProjectedSurfel<T>& ps = st.projected[id];
+        const raster::PixelRect r = clip_to_tile(ps.rect, tr);
+        const T* color = &surfels.colors[std::size_t(id) * channels];
+        std::fill_n(reinterpret_cast<T*>(&lg), sizeof(lg) / sizeof(T), T(0));
+        for (int y = r.y0; y <= r.y1; ++y) {
+            const T px0 = T(tr.x0) + T(0.5), py = T(y) + T(0.5);
+            raster::evaluate_splat_row(st.splats[id], px0, py, r.x0 - tr.x0, r.x1 - tr.x0, row);
+            backward_row(s, lg, (y - tr.y0) * kTileSize, row, st.splats[id], px0, py, color, channels,
+                         ps.normal, std::int32_t(e), std::int32_t(e - begin + 1));
+        }
+        store_slot(lg, channels, &slots[std::size_t(e) * stride]);
+    }
+}
+
+}  // namespace lumigauss::cpu
