@@ -6,5 +6,6 @@ namespace lumigauss::cli {
 
 void register_info(CLI::App& app);
 void register_render(CLI::App& app);
+void register_synth(CLI::App& app);
 
 }  // namespace lumigauss::cli

@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", "lumigauss 0.1.0");
     lumigauss::cli::register_info(app);
     lumigauss::cli::register_render(app);
+    lumigauss::cli::register_synth(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -1,0 +1,52 @@
+#pragma once
+// Analytic primitives of the synthetic landmarks and their ray intersection: axis-aligned boxes, vertical
+// cylinders (with caps), spheres and the ground square at z = 0. Every primitive is a closed solid (the
+// ground is only ever seen from above), so a ray from outside always meets an outward-facing surface.
+#include <optional>
+
+#include "lumigauss/math/vec.h"
+
+namespace lumigauss::synth {
+
+struct Ray {
+    Vec3d origin;
+    Vec3d dir;  // unit length
+};
+
+enum class Shape { kBox, kCylinder, kSphere, kGround };
+
+struct Primitive {
+    Shape shape = Shape::kBox;
+    Vec3d lo, hi;  // axis-aligned bounds (for every shape; for a box they are the box)
+    Vec3d center;  // cylinder: axis at (center.x, center.y), spanning lo.z..hi.z; sphere: centre
+    double radius = 0;
+    int material = 0;
+    bool transient = false;  // a pedestrian: part of one photo only, not of the static scene
+};
+
+Primitive make_box(Vec3d lo, Vec3d hi, int material);
+Primitive make_cylinder(double x, double y, double radius, double z0, double z1, int material);
+Primitive make_sphere(Vec3d center, double radius, int material);
+Primitive make_ground(double half_size, int material);
+
+struct Hit {
+    double t = 0;
+    Vec3d normal;  // outward unit normal
+    double u = 0;  // surface coordinates in metres (texture space)
+    double v = 0;
+};
+
+// The nearest hit with t in (t_min, t_max), if any.
+std::optional<Hit> intersect(const Primitive& p, const Ray& ray, double t_min, double t_max);
+
+// A point on the surface, uniformly distributed by area, for two uniforms a, b and a third c that picks a
+// face; returns the position and the outward normal. The ground is not sampled here (it is infinite in
+// effect; the point sampler draws it on a disc).
+struct SurfaceSample {
+    Vec3d position;
+    Vec3d normal;
+};
+double surface_area(const Primitive& p);
+SurfaceSample sample_surface(const Primitive& p, double a, double b, double c);
+
+}  // namespace lumigauss::synth

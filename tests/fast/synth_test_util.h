@@ -1,0 +1,116 @@
+#pragma once
+// Shared helpers of the Synth* tests: the tiny preset generated into a unique temporary folder (removed
+// afterwards), and small readers for what the project's loaders do not keep (COLMAP tracks, meta.json).
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "lumigauss/synth/synth.h"
+
+namespace lumigauss::synth_test {
+
+namespace fs = std::filesystem;
+
+// A fresh folder under the system temp dir, removed with the object.
+class TempDir {
+  public:
+    explicit TempDir(const std::string& tag) {
+        static std::atomic<int> counter{0};
+        path_ = fs::temp_directory_path() /
+                ("lumigauss_" + tag + "_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+        fs::remove_all(path_);
+        fs::create_directories(path_);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        fs::remove_all(path_, ec);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    std::string str() const { return path_.string(); }
+    std::string sub(const std::string& name) const { return (path_ / name).string(); }
+
+  private:
+    fs::path path_;
+};
+
+inline synth::SynthOptions tiny_options(const std::string& output_dir) {
+    synth::SynthOptions o = synth::synth_preset("tiny");
+    o.output_dir = output_dir;
+    return o;
+}
+
+inline nlohmann::json read_json(const std::string& path) {
+    std::ifstream f(path);
+    return nlohmann::json::parse(f);
+}
+
+inline std::string read_bytes(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    std::ostringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+// The parts of a COLMAP text model with tracks that io/colmap.h does not keep.
+struct TrackPoint {
+    int id = 0;
+    double x = 0, y = 0, z = 0, error = 0;
+    int r = 0, g = 0, b = 0;
+    std::vector<std::pair<int, int>> track;  // (image id, point2D index)
+};
+struct Point2D {
+    double x = 0, y = 0;
+    int point_id = -1;
+};
+struct TrackModel {
+    std::map<int, std::string> image_names;
+    std::map<int, std::vector<Point2D>> observations;  // per image id
+    std::vector<TrackPoint> points;
+};
+
+inline TrackModel read_tracks(const std::string& sparse_dir) {
+    TrackModel m;
+    std::ifstream images(sparse_dir + "/images.txt");
+    std::string line;
+    bool header_line = true;
+    int current = 0;
+    while (std::getline(images, line)) {
+        if (!line.empty() && line[0] == '#') continue;
+        std::istringstream s(line);
+        if (header_line) {
+            double q[7];
+            int cam = 0;
+            std::string name;
+            s >> current;
+            for (double& v : q) s >> v;
+            s >> cam >> name;
+            m.image_names[current] = name;
+            m.observations[current];
+        } else {
+            Point2D p;
+            while (s >> p.x >> p.y >> p.point_id) m.observations[current].push_back(p);
+        }
+        header_line = !header_line;
+    }
+    std::ifstream points(sparse_dir + "/points3D.txt");
+    while (std::getline(points, line)) {
+        if (line.empty() || line[0] == '#') continue;
+        std::istringstream s(line);
+        TrackPoint p;
+        s >> p.id >> p.x >> p.y >> p.z >> p.r >> p.g >> p.b >> p.error;
+        int image = 0, idx = 0;
+        while (s >> image >> idx) p.track.emplace_back(image, idx);
+        m.points.push_back(p);
+    }
+    return m;
+}
+
+}  // namespace lumigauss::synth_test
