@@ -9,21 +9,27 @@
 namespace lumigauss::bench {
 namespace {
 
-// Number of (pixel, surfel) pairs the per-pixel kernel evaluates: each entry's bounding square clipped to
-// its tile.
+// Work counts of one render: (pixel, surfel) pairs inside the surfels' boxes, and vector lanes the tiles
+// evaluate (8 or 16 per row of a box, see tile_forward.h's lane_window).
+struct WorkCounts {
+    double pairs = 0, lanes = 0, rows = 0;
+};
+
 template <typename T>
-double evaluated_pairs(const RasterState<T>& st) {
-    double pairs = 0;
+WorkCounts work_counts(const RasterState<T>& st) {
+    WorkCounts w;
     for (int t = 0; t < st.tiles_x * st.tiles_y; ++t) {
         const int tx = t % st.tiles_x, ty = t / st.tiles_x, ts = raster::kTileSize;
         for (std::uint32_t e = st.tile_start[t]; e < st.tile_start[t + 1]; ++e) {
-            const raster::PixelRect& r = st.projected[st.entry_surfel[e]].rect;
-            const int w = std::min(r.x1, tx * ts + ts - 1) - std::max(r.x0, tx * ts) + 1;
-            const int h = std::min(r.y1, ty * ts + ts - 1) - std::max(r.y0, ty * ts) + 1;
-            pairs += double(w) * h;
+            const raster::PixelRect& r = st.entry_rect[e];
+            const int cols = std::min(r.x1, tx * ts + ts - 1) - std::max(r.x0, tx * ts) + 1;
+            const int rows = std::min(r.y1, ty * ts + ts - 1) - std::max(r.y0, ty * ts) + 1;
+            w.pairs += double(cols) * rows;
+            w.rows += rows;
+            w.lanes += double(rows) * (cols <= 8 ? 8 : 16);
         }
     }
-    return pairs;
+    return w;
 }
 
 struct Fixture {
@@ -39,12 +45,14 @@ const Fixture& fixture(int width, int height, int count) {
 }
 
 void set_counters(benchmark::State& state, const RasterState<float>& st, const RasterImages<float>& img) {
-    const double pairs = evaluated_pairs(st);
+    const WorkCounts w = work_counts(st);
+    const double pairs = w.pairs;
     const double pixels = double(st.view.width) * st.view.height;
     double alpha = 0;
     for (float a : img.alpha) alpha += a;
     state.counters["intersections"] = double(st.intersections());
     state.counters["pairs_per_pixel"] = pairs / pixels;
+    state.counters["lanes_per_pixel"] = w.lanes / pixels;
     state.counters["pairs_per_s"] = benchmark::Counter(pairs, benchmark::Counter::kIsIterationInvariantRate);
     state.counters["mean_alpha"] = alpha / pixels;
 }

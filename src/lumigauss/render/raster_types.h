@@ -71,11 +71,17 @@ struct RasterState {
     std::vector<std::uint32_t> emission_offset;  // per surfel: first (surfel, tile) emission; size N + 1
     std::vector<std::uint32_t> tile_start;       // per tile: first sorted entry; size tiles + 1
     std::vector<std::uint32_t> entry_surfel;     // sorted entries: surfel id (per tile, front to back)
-    std::vector<std::uint32_t> emission_entry;   // emission -> sorted entry
-    std::vector<T> final_transmittance;          // per pixel
-    std::vector<std::uint32_t> contributors;     // per pixel: entries up to the last composited, in its tile
-    std::vector<std::int32_t> median_entry;      // per pixel: sorted entry giving the median depth, or -1
-    std::vector<T> m1, m2;                       // per pixel: sum w m, sum w m^2 (distortion)
+    std::vector<std::uint32_t> entry_emission;   // sorted entry -> its emission (slot of the backward)
+    // What the per-pixel loops read, gathered per sorted entry so tiles stream through memory instead of
+    // jumping between surfels: kernel geometry, pixel box and normal, and `channels` colours per entry.
+    std::vector<raster::SplatGeometry<T>> entry_splat;
+    std::vector<raster::PixelRect> entry_rect;
+    std::vector<Vec3<T>> entry_normal;
+    std::vector<T> entry_color;
+    std::vector<T> final_transmittance;       // per pixel
+    std::vector<std::uint32_t> contributors;  // per pixel: entries up to the last composited, in its tile
+    std::vector<std::int32_t> median_entry;   // per pixel: sorted entry giving the median depth, or -1
+    std::vector<T> m1, m2;                    // per pixel: sum w m, sum w m^2 (distortion)
     std::vector<T> background;
 
     std::size_t intersections() const { return entry_surfel.size(); }

@@ -113,12 +113,14 @@ struct RowSamples {
     T clamped[kTileSize];  // 1 where alpha hit kAlphaMax
 };
 
-template <typename T>
+// W (8 or 16) lanes starting at px0: callers use an 8-pixel window for boxes that fit in one, which halves
+// the work on processors whose 16-wide vectors are two 8-wide halves.
+template <int W = kTileSize, typename T>
 LG_HD inline void evaluate_splat_row(const SplatGeometry<T>& geometry, T px0, T py, int lo, int hi,
                                      RowSamples<T>& out) {
     const SplatGeometry<T> g = geometry;  // a local copy: the outputs cannot alias it, so the loop vectorises
     const T lo_t = T(lo), hi_t = T(hi);
-    for (int i = 0; i < kTileSize; ++i) {
+    for (int i = 0; i < W; ++i) {
         SplatSample<T> s;
         const bool ok = evaluate_splat(g, px0 + T(i), py, s);
         const T a = ok ? s.alpha : T(0);

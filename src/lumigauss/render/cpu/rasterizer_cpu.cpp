@@ -62,6 +62,26 @@ void project_all(const SurfelBatch<T>& surfels, RasterState<T>& st) {
     });
 }
 
+// Copies what the per-pixel loops read into sorted-entry order (see RasterState::entry_splat).
+template <typename T>
+void gather_entries(const SurfelBatch<T>& surfels, RasterState<T>& st) {
+    const std::size_t m = st.intersections();
+    const int C = surfels.channels;
+    st.entry_splat.resize(m);
+    st.entry_rect.resize(m);
+    st.entry_normal.resize(m);
+    st.entry_color.resize(m * std::size_t(C));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 4096), [&](const auto& r) {
+        for (std::size_t e = r.begin(); e != r.end(); ++e) {
+            const std::uint32_t id = st.entry_surfel[e];
+            st.entry_splat[e] = st.splats[id];
+            st.entry_rect[e] = st.projected[id].rect;
+            st.entry_normal[e] = st.projected[id].normal;
+            std::copy_n(&surfels.colors[std::size_t(id) * C], C, &st.entry_color[e * C]);
+        }
+    });
+}
+
 template <typename T>
 void allocate_images(RasterImages<T>& img, int width, int height, int channels) {
     const std::size_t np = std::size_t(width) * height;
@@ -91,7 +111,7 @@ void reduce_surfel_gradients(const SurfelBatch<T>& surfels, const RasterState<T>
             if (!st.visible[i]) continue;
             std::fill(sum.begin(), sum.end(), T(0));
             for (std::uint32_t em = st.emission_offset[i]; em < st.emission_offset[i + 1]; ++em) {
-                const T* slot = &slots[std::size_t(st.emission_entry[em]) * stride];
+                const T* slot = &slots[std::size_t(em) * stride];
                 for (int k = 0; k < stride; ++k) sum[k] += slot[k];
             }
             raster::SplatGrad<T> sg;
@@ -135,6 +155,7 @@ RasterImages<T> rasterize_forward_cpu(const Camera& camera, const SurfelBatch<T>
     check_channels(surfels.channels);
     project_all(surfels, st);
     bin_surfels_to_tiles(st);
+    gather_entries(surfels, st);
 
     const std::size_t np = std::size_t(camera.width) * camera.height;
     st.final_transmittance.resize(np);

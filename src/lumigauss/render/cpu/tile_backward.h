@@ -49,7 +49,7 @@ struct LaneGrads {
     alignas(64) T color[C][kTileSize];
 };
 
-template <typename T, int C>
+template <int W, typename T, int C>
 LG_ALWAYS_INLINE void backward_row(TileBackwardState<T, C>& s, LaneGrads<T, C>& lg, int row_offset,
                                    const raster::RowSamples<T>& row, const raster::SplatGeometry<T>& geometry,
                                    T px0, T py, const T* color, int channels, Vec3<T> normal,
@@ -58,7 +58,7 @@ LG_ALWAYS_INLINE void backward_row(TileBackwardState<T, C>& s, LaneGrads<T, C>& 
     T col[C];
     for (int c = 0; c < C; ++c) col[c] = c < channels ? color[c] : T(0);
 #pragma omp simd
-    for (int i = 0; i < kTileSize; ++i) {
+    for (int i = 0; i < W; ++i) {
         const int p = row_offset + i;
         // Only pairs the forward composited: inside the pixel's contributor range, alpha above threshold.
         const T a = rank <= s.contributors[p] ? row.alpha[i] : T(0);
@@ -175,8 +175,8 @@ LG_ALWAYS_INLINE void store_slot(const LaneGrads<T, C>& lg, int channels, T* slo
 }
 
 template <typename T, int C>
-LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const SurfelBatch<T>& surfels,
-                                           const RasterState<T>& st, const RasterImageGrads<T>& g, T* slots) {
+LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterState<T>& st,
+                                           const RasterImageGrads<T>& g, T* slots) {
     const int stride = SlotLayout::stride(channels);
     const raster::PixelRect tr = tile_pixels(tile, st.tiles_x, st.view.width, st.view.height);
     TileBackwardState<T, C> s;
@@ -186,21 +186,30 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const SurfelB
     raster::RowSamples<T> row;
     LaneGrads<T, C> lg;
     const std::uint32_t begin = st.tile_start[tile], end = st.tile_start[tile + 1];
+    // Slots are indexed by emission (contiguous per surfel) so the per-surfel reduction streams.
     for (std::uint32_t e = begin + last_rank; e < end; ++e)  // never visited: zero slots
-        std::fill_n(&slots[std::size_t(e) * stride], stride, T(0));
+        std::fill_n(&slots[std::size_t(st.entry_emission[e]) * stride], stride, T(0));
     for (std::uint32_t e = begin + last_rank; e-- > begin;) {
-        const std::uint32_t id = st.entry_surfel[e];
-        const raster::ProjectedSurfel<T>& ps = st.projected[id];
-        const raster::PixelRect r = clip_to_tile(ps.rect, tr);
-        const T* color = &surfels.colors[std::size_t(id) * channels];
+        const raster::PixelRect r = clip_to_tile(st.entry_rect[e], tr);
+        const T* color = &st.entry_color[std::size_t(e) * channels];
+        const raster::SplatGeometry<T>& geo = st.entry_splat[e];
         std::fill_n(reinterpret_cast<T*>(&lg), sizeof(lg) / sizeof(T), T(0));
+        const LaneWindow win = lane_window(r, tr);
         for (int y = r.y0; y <= r.y1; ++y) {
-            const T px0 = T(tr.x0) + T(0.5), py = T(y) + T(0.5);
-            raster::evaluate_splat_row(st.splats[id], px0, py, r.x0 - tr.x0, r.x1 - tr.x0, row);
-            backward_row(s, lg, (y - tr.y0) * kTileSize, row, st.splats[id], px0, py, color, channels,
-                         ps.normal, std::int32_t(e), std::int32_t(e - begin + 1));
+            const T px0 = T(tr.x0 + win.first) + T(0.5), py = T(y) + T(0.5);
+            const int offset = (y - tr.y0) * kTileSize + win.first;
+            const auto rank = std::int32_t(e - begin + 1);
+            if (win.narrow) {
+                raster::evaluate_splat_row<kNarrow>(geo, px0, py, win.lo, win.hi, row);
+                backward_row<kNarrow>(s, lg, offset, row, geo, px0, py, color, channels, st.entry_normal[e],
+                                      std::int32_t(e), rank);
+            } else {
+                raster::evaluate_splat_row<kTileSize>(geo, px0, py, win.lo, win.hi, row);
+                backward_row<kTileSize>(s, lg, offset, row, geo, px0, py, color, channels, st.entry_normal[e],
+                                        std::int32_t(e), rank);
+            }
         }
-        store_slot(lg, channels, &slots[std::size_t(e) * stride]);
+        store_slot(lg, channels, &slots[std::size_t(st.entry_emission[e]) * stride]);
     }
 }
 

@@ -4,6 +4,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <numeric>
 
 namespace lumigauss {
@@ -49,31 +51,29 @@ void bin_surfels_to_tiles(RasterState<T>& st) {
     for (std::uint32_t t : emission_tile) ++st.tile_start[t + 1];
     std::partial_sum(st.tile_start.begin(), st.tile_start.end(), st.tile_start.begin());
 
-    // Scatter emissions into tile order; within a tile they stay in surfel order for now.
-    std::vector<std::uint32_t> entry_emission(total);
-    {
-        std::vector<std::uint32_t> cursor(st.tile_start.begin(), st.tile_start.end() - 1);
-        for (std::uint32_t e = 0; e < total; ++e) entry_emission[cursor[emission_tile[e]]++] = e;
-    }
+    // Scatter the emissions into tile order as sort keys: the depth's float bits (positive floats order like
+    // their bit patterns) above the emission index, which breaks ties deterministically, in surfel order.
     std::vector<std::uint32_t> emission_surfel(total);
     for (std::size_t i = 0; i < n; ++i)
         std::fill(emission_surfel.begin() + st.emission_offset[i],
                   emission_surfel.begin() + st.emission_offset[i + 1], std::uint32_t(i));
-
+    std::vector<std::uint64_t> keys(total);
+    {
+        std::vector<std::uint32_t> cursor(st.tile_start.begin(), st.tile_start.end() - 1);
+        for (std::uint32_t e = 0; e < total; ++e) {
+            const auto depth = float(st.projected[emission_surfel[e]].depth);
+            keys[cursor[emission_tile[e]]++] = (std::uint64_t(std::bit_cast<std::uint32_t>(depth)) << 32) | e;
+        }
+    }
     st.entry_surfel.resize(total);
-    st.emission_entry.resize(total);
+    st.entry_emission.resize(total);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, num_tiles, 4), [&](const auto& r) {
         for (std::size_t t = r.begin(); t != r.end(); ++t) {
-            auto first = entry_emission.begin() + st.tile_start[t];
-            auto last = entry_emission.begin() + st.tile_start[t + 1];
-            std::sort(first, last, [&](std::uint32_t a, std::uint32_t b) {
-                const std::uint32_t sa = emission_surfel[a], sb = emission_surfel[b];
-                const T da = st.projected[sa].depth, db = st.projected[sb].depth;
-                return da < db || (da == db && sa < sb);
-            });
+            std::sort(keys.begin() + st.tile_start[t], keys.begin() + st.tile_start[t + 1]);
             for (std::uint32_t k = st.tile_start[t]; k < st.tile_start[t + 1]; ++k) {
-                st.entry_surfel[k] = emission_surfel[entry_emission[k]];
-                st.emission_entry[entry_emission[k]] = k;
+                const auto e = std::uint32_t(keys[k] & 0xffffffffu);
+                st.entry_surfel[k] = emission_surfel[e];
+                st.entry_emission[k] = e;
             }
         }
     });

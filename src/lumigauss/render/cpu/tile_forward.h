@@ -32,6 +32,24 @@ inline raster::PixelRect clip_to_tile(const raster::PixelRect& rect, const raste
             std::min(rect.y1, tile.y1)};
 }
 
+// The lanes a surfel's box needs in a tile row: an 8-pixel window when the box fits in one (most do), else
+// the whole 16-pixel row. lo and hi are the box's first and last pixel relative to the window.
+inline constexpr int kNarrow = 8;
+struct LaneWindow {
+    bool narrow;
+    int first;  // first pixel of the window, relative to the tile
+    int lo, hi;
+};
+
+inline LaneWindow lane_window(const raster::PixelRect& r, const raster::PixelRect& tile) {
+    const int x0 = r.x0 - tile.x0, x1 = r.x1 - tile.x0;
+    if (x1 - x0 < kNarrow) {
+        const int first = std::min(x0, kTileSize - kNarrow);
+        return {true, first, x0 - first, x1 - first};
+    }
+    return {false, 0, x0, x1};
+}
+
 template <typename T, int C>
 struct TileForwardState {
     alignas(64) T live[kTilePixels];  // 1 while the pixel still blends; 0 once finished or off the image
@@ -49,14 +67,14 @@ struct TileForwardState {
 
 // Blends one surfel into one tile row. `entry` is its index in the sorted list, `rank` its position in the
 // tile's list plus one (what a pixel records as its contributor count).
-template <typename T, int C>
+template <int W, typename T, int C>
 LG_ALWAYS_INLINE void blend_row(TileForwardState<T, C>& s, int row_offset, const raster::RowSamples<T>& row,
                                 const T* color, int channels, Vec3<T> normal, std::int32_t entry,
                                 std::int32_t rank) {
     T col[C];
     for (int c = 0; c < C; ++c) col[c] = c < channels ? color[c] : T(0);
 #pragma omp simd
-    for (int i = 0; i < kTileSize; ++i) {
+    for (int i = 0; i < W; ++i) {
         const int p = row_offset + i;
         const T a = row.alpha[i] * s.live[p];
         const T t = s.trans[p];
@@ -90,8 +108,7 @@ LG_ALWAYS_INLINE bool any_live(const TileForwardState<T, C>& s) {
 }
 
 template <typename T, int C>
-LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, const SurfelBatch<T>& surfels,
-                                          RasterState<T>& st, RasterImages<T>& img) {
+LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, RasterState<T>& st, RasterImages<T>& img) {
     const int width = st.view.width;
     const raster::PixelRect tr = tile_pixels(tile, st.tiles_x, width, st.view.height);
     TileForwardState<T, C> s;
@@ -110,15 +127,22 @@ LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, const SurfelBa
     for (std::uint32_t e = begin; e < end; ++e) {
         // Finished tiles stop early; checking every few entries keeps the check off the hot path.
         if ((e - begin) % 8 == 7 && !any_live(s)) break;
-        const std::uint32_t id = st.entry_surfel[e];
-        const raster::ProjectedSurfel<T>& ps = st.projected[id];
-        const raster::PixelRect r = clip_to_tile(ps.rect, tr);
-        const T* color = &surfels.colors[std::size_t(id) * channels];
+        const raster::PixelRect r = clip_to_tile(st.entry_rect[e], tr);
+        const T* color = &st.entry_color[std::size_t(e) * channels];
+        const LaneWindow win = lane_window(r, tr);
         for (int y = r.y0; y <= r.y1; ++y) {
-            raster::evaluate_splat_row(st.splats[id], T(tr.x0) + T(0.5), T(y) + T(0.5), r.x0 - tr.x0,
-                                       r.x1 - tr.x0, row);
-            blend_row(s, (y - tr.y0) * kTileSize, row, color, channels, ps.normal, std::int32_t(e),
-                      std::int32_t(e - begin + 1));
+            const T px0 = T(tr.x0 + win.first) + T(0.5), py = T(y) + T(0.5);
+            const int offset = (y - tr.y0) * kTileSize + win.first;
+            const auto rank = std::int32_t(e - begin + 1);
+            if (win.narrow) {
+                raster::evaluate_splat_row<kNarrow>(st.entry_splat[e], px0, py, win.lo, win.hi, row);
+                blend_row<kNarrow>(s, offset, row, color, channels, st.entry_normal[e], std::int32_t(e),
+                                   rank);
+            } else {
+                raster::evaluate_splat_row<kTileSize>(st.entry_splat[e], px0, py, win.lo, win.hi, row);
+                blend_row<kTileSize>(s, offset, row, color, channels, st.entry_normal[e], std::int32_t(e),
+                                     rank);
+            }
         }
     }
 

@@ -19,22 +19,22 @@ template <typename T>
 LG_ALWAYS_INLINE void forward_any(int tile, const SurfelBatch<T>& s, RasterState<T>& st,
                                   RasterImages<T>& img) {
     if (s.channels == 3)
-        render_tile_forward<T, 3>(tile, 3, s, st, img);
+        render_tile_forward<T, 3>(tile, 3, st, img);
     else if (s.channels == 6)
-        render_tile_forward<T, 6>(tile, 6, s, st, img);
+        render_tile_forward<T, 6>(tile, 6, st, img);
     else
-        render_tile_forward<T, kMaxChannels>(tile, s.channels, s, st, img);
+        render_tile_forward<T, kMaxChannels>(tile, s.channels, st, img);
 }
 
 template <typename T>
 LG_ALWAYS_INLINE void backward_any(int tile, const SurfelBatch<T>& s, const RasterState<T>& st,
                                    const RasterImageGrads<T>& g, T* slots) {
     if (s.channels == 3)
-        render_tile_backward<T, 3>(tile, 3, s, st, g, slots);
+        render_tile_backward<T, 3>(tile, 3, st, g, slots);
     else if (s.channels == 6)
-        render_tile_backward<T, 6>(tile, 6, s, st, g, slots);
+        render_tile_backward<T, 6>(tile, 6, st, g, slots);
     else
-        render_tile_backward<T, kMaxChannels>(tile, s.channels, s, st, g, slots);
+        render_tile_backward<T, kMaxChannels>(tile, s.channels, st, g, slots);
 }
 
 LG_MULTIVERSION void forward_tile(int tile, const SurfelBatch<float>& s, RasterState<float>& st,
