@@ -6,3 +6,14 @@
 #else
 #define LG_HD
 #endif
+
+// For the per-pixel kernels: inlined into every caller even in very large translation units (the CPU
+// backend compiles each kernel for several instruction sets), since a call inside a pixel loop stops it
+// from vectorising.
+#if defined(__CUDACC__)
+#define LG_HD_INLINE __host__ __device__ __forceinline__
+#elif defined(__GNUC__)
+#define LG_HD_INLINE __attribute__((always_inline)) inline
+#else
+#define LG_HD_INLINE inline
+#endif

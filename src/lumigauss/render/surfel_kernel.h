@@ -23,7 +23,7 @@ struct SplatSample {
 // degree-6 polynomial (Cephes expf coefficients, about 1 ulp) written without branches or libm calls so
 // that loops over pixels vectorise; double: std::exp (references and finite-difference tests).
 template <typename T>
-LG_HD inline T kernel_exp(T x) {
+LG_HD_INLINE T kernel_exp(T x) {
     if constexpr (sizeof(T) == sizeof(float)) {
         x = x < -87.0f ? -87.0f : x;
         const float round_magic = 12582912.0f;  // 1.5 * 2^23: adding it rounds to an integer
@@ -78,7 +78,7 @@ LG_HD inline SplatGeometry<T> make_splat_geometry(Vec3<T> tu, Vec3<T> tv, Vec3<T
 // Written without early returns (every test folds into the result) so that loops over pixels vectorise;
 // a parallel ray makes u, v infinite or NaN, and every comparison below then fails.
 template <typename T>
-LG_HD inline bool evaluate_splat(const SplatGeometry<T>& g, T px, T py, SplatSample<T>& s) {
+LG_HD_INLINE bool evaluate_splat(const SplatGeometry<T>& g, T px, T py, SplatSample<T>& s) {
     const T dx = px - g.center.x, dy = py - g.center.y;
     const Vec3<T> p = dx * g.pa + dy * g.pb + g.pd;
     const T inv_pz = T(1) / p.z;
@@ -116,7 +116,7 @@ struct RowSamples {
 // W (8 or 16) lanes starting at px0: callers use an 8-pixel window for boxes that fit in one, which halves
 // the work on processors whose 16-wide vectors are two 8-wide halves.
 template <int W = kTileSize, typename T>
-LG_HD inline void evaluate_splat_row(const SplatGeometry<T>& geometry, T px0, T py, int lo, int hi,
+LG_HD_INLINE void evaluate_splat_row(const SplatGeometry<T>& geometry, T px0, T py, int lo, int hi,
                                      RowSamples<T>& out) {
     const SplatGeometry<T> g = geometry;  // a local copy: the outputs cannot alias it, so the loop vectorises
     const T lo_t = T(lo), hi_t = T(hi);
@@ -157,7 +157,7 @@ struct SplatGradTerms {
 // The sample is passed field by field (not as SplatSample) so that vectorised callers need not assemble
 // structs with bool members per pixel.
 template <typename T>
-LG_HD inline SplatGradTerms<T> splat_grad_terms(const SplatGeometry<T>& g, T px, T py, T sample_u, T sample_v,
+LG_HD_INLINE SplatGradTerms<T> splat_grad_terms(const SplatGeometry<T>& g, T px, T py, T sample_u, T sample_v,
                                                 T gauss, bool screen_branch, bool clamped, T g_alpha, T g_z) {
     SplatGradTerms<T> t;
     // The alpha clamp is differentiated exactly: no gradient through a clamped alpha.
@@ -212,12 +212,12 @@ LG_HD inline void to_ray_transform_grad(Vec3<T> tu, Vec3<T> tv, Vec3<T> tw, Vec2
 
 // Depth mapping used by the distortion loss: m = f/(f-n) (1 - n/z), NDC-like in [0, 1).
 template <typename T>
-LG_HD inline T distortion_depth(T z) {
+LG_HD_INLINE T distortion_depth(T z) {
     const T n = T(kNearPlane), f = T(kFarPlane);
     return f / (f - n) * (T(1) - n / z);
 }
 template <typename T>
-LG_HD inline T distortion_depth_derivative(T z) {
+LG_HD_INLINE T distortion_depth_derivative(T z) {
     const T n = T(kNearPlane), f = T(kFarPlane);
     return f * n / ((f - n) * z * z);
 }

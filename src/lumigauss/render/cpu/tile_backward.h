@@ -154,11 +154,12 @@ LG_ALWAYS_INLINE void load_tile_backward_state(TileBackwardState<T, C>& s, const
         }
 }
 
-template <typename T, int C>
+// Sums the first W lanes of each accumulator into the slot (8 lanes hold everything for narrow windows).
+template <int W, typename T, int C>
 LG_ALWAYS_INLINE void store_slot(const LaneGrads<T, C>& lg, int channels, T* slot) {
     const auto lane_sum = [](const T* v) {
         T sum = 0;
-        for (int i = 0; i < kTileSize; ++i) sum += v[i];
+        for (int i = 0; i < W; ++i) sum += v[i];
         return sum;
     };
     for (int k = 0; k < 3; ++k) {
@@ -193,8 +194,8 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
         const raster::PixelRect r = clip_to_tile(st.entry_rect[e], tr);
         const T* color = &st.entry_color[std::size_t(e) * channels];
         const raster::SplatGeometry<T>& geo = st.entry_splat[e];
-        std::fill_n(reinterpret_cast<T*>(&lg), sizeof(lg) / sizeof(T), T(0));
         const LaneWindow win = lane_window(r, tr);
+        std::fill_n(reinterpret_cast<T*>(&lg), sizeof(lg) / sizeof(T), T(0));
         for (int y = r.y0; y <= r.y1; ++y) {
             const T px0 = T(tr.x0 + win.first) + T(0.5), py = T(y) + T(0.5);
             const int offset = (y - tr.y0) * kTileSize + win.first;
@@ -209,7 +210,11 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
                                         std::int32_t(e), rank);
             }
         }
-        store_slot(lg, channels, &slots[std::size_t(st.entry_emission[e]) * stride]);
+        T* slot = &slots[std::size_t(st.entry_emission[e]) * stride];
+        if (win.narrow)
+            store_slot<kNarrow>(lg, channels, slot);
+        else
+            store_slot<kTileSize>(lg, channels, slot);
     }
 }
 
