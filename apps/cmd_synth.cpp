@@ -14,11 +14,11 @@ namespace {
 
 struct SynthFlags {
     std::string output, preset = "demo", scene = "plaza";
-    int width = 0, height = 0, train = 0, test = 0, spp_side = 0, points = 0;
+    int width = 0, height = 0, train = 0, test = 0, spp_side = 0, points = 0, gt_surfels = 0;
     unsigned long long seed = 1;
     double transients = 0;
     bool force = false, verbose = false;
-    CLI::Option *o_width, *o_height, *o_train, *o_test, *o_transients, *o_spp, *o_points;
+    CLI::Option *o_width, *o_height, *o_train, *o_test, *o_transients, *o_spp, *o_points, *o_gt_surfels;
 };
 
 synth::SynthOptions to_options(const SynthFlags& f) {
@@ -33,6 +33,7 @@ synth::SynthOptions to_options(const SynthFlags& f) {
     if (f.o_transients->count()) o.transient_fraction = f.transients;
     if (f.o_spp->count()) o.samples_per_side = f.spp_side;
     if (f.o_points->count()) o.point_candidates = f.points;
+    if (f.o_gt_surfels->count()) o.gt_surfels = f.gt_surfels;
     o.overwrite = f.force;
     o.verbose = f.verbose;
     return o;
@@ -43,9 +44,9 @@ void run_synth(const SynthFlags& f) {
     const synth::SynthSummary s = synth::generate_synthetic_scene(o);
     std::printf(
         "synth: wrote %s: scene %s, %dx%d, %d train (%d with pedestrians) + %d test photos, %d lighting "
-        "conditions, %d points3D in %.2f s\n",
+        "conditions, %d points3D, %d ground-truth surfels in %.2f s\n",
         o.output_dir.c_str(), o.scene.c_str(), o.width, o.height, s.n_train, s.n_with_transients, s.n_test,
-        s.n_conditions, s.n_points, s.seconds);
+        s.n_conditions, s.n_points, s.n_gt_surfels, s.seconds);
 }
 
 }  // namespace
@@ -81,6 +82,10 @@ void register_synth(CLI::App& app) {
                    ->check(CLI::Range(1, 16));
     f->o_points = cmd->add_option("--points", f->points, "Surface samples tried for points3D")
                       ->check(CLI::Range(0, 10000000));
+    f->o_gt_surfels =
+        cmd->add_option("--gt-surfels", f->gt_surfels,
+                        "About how many ground-truth surfels to write to gt/surfels.ply (0: no file)")
+            ->check(CLI::Range(0, 10000000));
     cmd->add_flag("--force", f->force, "Replace the dataset files of an existing output folder");
     cmd->add_flag("-v,--verbose", f->verbose, "Print each photo as it is rendered");
     cmd->callback([f] { run_synth(*f); });

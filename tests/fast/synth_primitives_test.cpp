@@ -67,6 +67,40 @@ TEST(SynthPrimitives, SurfaceSamplesLieOnTheSurface) {
         }
 }
 
+// The faces partition the surface: their areas add up, each maps the unit square onto the surface with the
+// face's own normal, uniformly by area (the image of a small parameter square has area face_area * da * db).
+TEST(SynthPrimitives, FacesMapTheUnitSquareUniformlyByArea) {
+    const synth::Primitive prims[] = {synth::make_box({-1, -2, 0}, {3, 1, 2}, 0),
+                                      synth::make_cylinder(1, 1, 0.7, 0.5, 3, 0),
+                                      synth::make_sphere({0, 2, 1}, 1.5, 0)};
+    synth::Rng rng(9);
+    for (const auto& p : prims) {
+        double total = 0;
+        for (int f = 0; f < synth::face_count(p); ++f) {
+            total += synth::face_area(p, f);
+            for (int i = 0; i < 50; ++i) {
+                const double a = rng.uniform(0.05, 0.95), b = rng.uniform(0.05, 0.95), d = 1e-5;
+                const auto s = synth::sample_face(p, f, a, b);
+                const auto h = synth::intersect(p, Ray{s.position + 1e-3 * s.normal, -s.normal}, 0, 1);
+                ASSERT_TRUE(h);
+                EXPECT_NEAR(h->t, 1e-3, 1e-9);
+                EXPECT_NEAR(dot(h->normal, s.normal), 1.0, 1e-9);
+                const Vec3d du = synth::sample_face(p, f, a + d, b).position - s.position;
+                const Vec3d dv = synth::sample_face(p, f, a, b + d).position - s.position;
+                EXPECT_NEAR(dot(du, dv), 0.0, 1e-3 * length(du) * length(dv));  // orthogonal parameters
+                EXPECT_NEAR(length(cross(du, dv)) / (d * d), synth::face_area(p, f),
+                            1e-3 * synth::face_area(p, f));
+            }
+        }
+        EXPECT_NEAR(total, synth::surface_area(p), 1e-9 * total);
+        // Inside is strictly inside: the centre of the bounds is, a lifted surface point is not.
+        EXPECT_TRUE(synth::contains(p, 0.5 * (p.lo + p.hi)));
+        const auto s = synth::sample_face(p, 0, 0.3, 0.6);
+        EXPECT_FALSE(synth::contains(p, s.position + 1e-6 * s.normal));
+        EXPECT_TRUE(synth::contains(p, s.position - 1e-6 * s.normal));
+    }
+}
+
 TEST(SynthPrimitives, LandmarksAreWithinTheirBoundsAndCastShadows) {
     for (const std::string& name : synth::landmark_names()) {
         const synth::Landmark l = synth::build_landmark(name);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "lumigauss/io/camera.h"
+#include "lumigauss/synth/gt_surfels.h"
 #include "lumigauss/synth/ray_tracer.h"
 #include "lumigauss/synth/sfm_points.h"
 #include "lumigauss/synth/sky.h"
@@ -45,6 +46,7 @@ struct MetaInputs {
     int n_points;
     double noise_sigma;
     double scene_diag;
+    const GtSurfels* gt_surfels;  // empty model when none were written
 };
 void write_meta_json(const std::string& dir, const MetaInputs& in);
 void write_readme(const std::string& dir, const MetaInputs& in);

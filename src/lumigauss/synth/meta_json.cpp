@@ -109,6 +109,15 @@ void write_meta_json(const std::string& dir, const MetaInputs& in) {
         images.push_back(image_json(p, (*in.conditions)[std::size_t(p.condition)].id));
     j["images"] = images;
     j["n_points3D"] = in.n_points;
+    if (in.gt_surfels && in.gt_surfels->model.size() > 0) {
+        const GtSurfels& g = *in.gt_surfels;
+        j["gt_surfels"] = {{"path", "gt/surfels.ply"},
+                           {"count", g.model.size()},
+                           {"cell_m", g.cell},
+                           {"ground_cell_m", g.ground_cell},
+                           {"ground_near_radius_m", g.near_radius},
+                           {"colour", "SH degree 0, 0.5 + 0.28209479 * f_dc = linear albedo"}};
+    }
     write_file_atomically(dir + "/meta.json", j.dump(1) + "\n");
 }
 

@@ -182,6 +182,24 @@ std::optional<Hit> intersect(const Primitive& p, const Ray& ray, double t_min, d
     return std::nullopt;
 }
 
+bool contains(const Primitive& p, Vec3d q) {
+    const auto in_open = [](double v, double lo, double hi) { return v > lo && v < hi; };
+    switch (p.shape) {
+        case Shape::kBox:
+            return in_open(q.x, p.lo.x, p.hi.x) && in_open(q.y, p.lo.y, p.hi.y) &&
+                   in_open(q.z, p.lo.z, p.hi.z);
+        case Shape::kCylinder: {
+            const double dx = q.x - p.center.x, dy = q.y - p.center.y;
+            return in_open(q.z, p.lo.z, p.hi.z) && dx * dx + dy * dy < p.radius * p.radius;
+        }
+        case Shape::kSphere:
+            return length(q - p.center) < p.radius;
+        case Shape::kGround:
+            return false;
+    }
+    return false;
+}
+
 namespace {
 
 double box_face_area(const Primitive& b, int axis) {
@@ -189,13 +207,8 @@ double box_face_area(const Primitive& b, int axis) {
     return axis == 0 ? e.y * e.z : (axis == 1 ? e.x * e.z : e.x * e.y);
 }
 
-SurfaceSample sample_box(const Primitive& b, double a, double bb, double c) {
-    // Pick one of the six faces with probability proportional to its area.
-    double areas[6], total = 0;
-    for (int f = 0; f < 6; ++f) total += areas[f] = box_face_area(b, f / 2);
-    double pick = c * total;
-    int face = 0;
-    while (face < 5 && pick >= areas[face]) pick -= areas[face++];
+// Face 2 * axis + high: the face at lo[axis] (high = 0) or hi[axis], spanned by the next two axes.
+SurfaceSample sample_box_face(const Primitive& b, int face, double a, double bb) {
     const int axis = face / 2;
     const bool high = face % 2 == 1;
     const int ua = (axis + 1) % 3, va = (axis + 2) % 3;
@@ -207,17 +220,16 @@ SurfaceSample sample_box(const Primitive& b, double a, double bb, double c) {
     return s;
 }
 
-SurfaceSample sample_cylinder(const Primitive& cy, double a, double b, double c) {
-    const double side = 2 * kPi * cy.radius * (cy.hi.z - cy.lo.z), cap = kPi * cy.radius * cy.radius;
-    const double pick = c * (side + 2 * cap);
+// Face 0 the side, 1 the bottom cap, 2 the top cap.
+SurfaceSample sample_cylinder_face(const Primitive& cy, int face, double a, double b) {
     SurfaceSample s;
-    if (pick < side) {
+    if (face == 0) {
         const double phi = 2 * kPi * a;
         s.normal = {std::cos(phi), std::sin(phi), 0.0};
         s.position = {cy.center.x + cy.radius * s.normal.x, cy.center.y + cy.radius * s.normal.y,
                       cy.lo.z + b * (cy.hi.z - cy.lo.z)};
     } else {
-        const bool top = pick >= side + cap;
+        const bool top = face == 2;
         const double r = cy.radius * std::sqrt(a), phi = 2 * kPi * b;
         s.normal = {0.0, 0.0, top ? 1.0 : -1.0};
         s.position = {cy.center.x + r * std::cos(phi), cy.center.y + r * std::sin(phi),
@@ -236,12 +248,26 @@ SurfaceSample sample_sphere(const Primitive& sp, double a, double b) {
 
 }  // namespace
 
-double surface_area(const Primitive& p) {
+int face_count(const Primitive& p) {
     switch (p.shape) {
         case Shape::kBox:
-            return 2 * (box_face_area(p, 0) + box_face_area(p, 1) + box_face_area(p, 2));
+            return 6;
         case Shape::kCylinder:
-            return 2 * kPi * p.radius * (p.hi.z - p.lo.z) + 2 * kPi * p.radius * p.radius;
+            return 3;
+        case Shape::kSphere:
+            return 1;
+        case Shape::kGround:
+            return 0;
+    }
+    return 0;
+}
+
+double face_area(const Primitive& p, int face) {
+    switch (p.shape) {
+        case Shape::kBox:
+            return box_face_area(p, face / 2);
+        case Shape::kCylinder:
+            return face == 0 ? 2 * kPi * p.radius * (p.hi.z - p.lo.z) : kPi * p.radius * p.radius;
         case Shape::kSphere:
             return 4 * kPi * p.radius * p.radius;
         case Shape::kGround:
@@ -250,18 +276,50 @@ double surface_area(const Primitive& p) {
     return 0.0;
 }
 
-SurfaceSample sample_surface(const Primitive& p, double a, double b, double c) {
+Vec2<double> face_extent(const Primitive& p, int face) {
+    switch (p.shape) {
+        case Shape::kBox: {
+            const int axis = face / 2;
+            return {p.hi[(axis + 1) % 3] - p.lo[(axis + 1) % 3], p.hi[(axis + 2) % 3] - p.lo[(axis + 2) % 3]};
+        }
+        case Shape::kCylinder:  // a cap: the radius, and the circumference halfway out by area
+            return face == 0 ? Vec2<double>{2 * kPi * p.radius, p.hi.z - p.lo.z}
+                             : Vec2<double>{p.radius, std::sqrt(2.0) * kPi * p.radius};
+        case Shape::kSphere:  // a meridian, and the mean circumference of a parallel
+            return {kPi * p.radius, 0.5 * kPi * kPi * p.radius};
+        case Shape::kGround:
+            break;
+    }
+    return {0.0, 0.0};
+}
+
+SurfaceSample sample_face(const Primitive& p, int face, double a, double b) {
     switch (p.shape) {
         case Shape::kBox:
-            return sample_box(p, a, b, c);
+            return sample_box_face(p, face, a, b);
         case Shape::kCylinder:
-            return sample_cylinder(p, a, b, c);
+            return sample_cylinder_face(p, face, a, b);
         case Shape::kSphere:
             return sample_sphere(p, a, b);
         case Shape::kGround:
             break;
     }
     return {{a, b, 0.0}, {0.0, 0.0, 1.0}};
+}
+
+double surface_area(const Primitive& p) {
+    double total = 0;
+    for (int f = 0; f < face_count(p); ++f) total += face_area(p, f);
+    return total;
+}
+
+SurfaceSample sample_surface(const Primitive& p, double a, double b, double c) {
+    const int n = face_count(p);
+    if (n == 0) return sample_face(p, 0, a, b);
+    double pick = c * surface_area(p);
+    int face = 0;
+    while (face + 1 < n && pick >= face_area(p, face)) pick -= face_area(p, face++);
+    return sample_face(p, face, a, b);
 }
 
 }  // namespace lumigauss::synth

@@ -39,6 +39,9 @@ struct Hit {
 // The nearest hit with t in (t_min, t_max), if any.
 std::optional<Hit> intersect(const Primitive& p, const Ray& ray, double t_min, double t_max);
 
+// Whether a point lies strictly inside the solid (never for the ground).
+bool contains(const Primitive& p, Vec3d point);
+
 // A point on the surface, uniformly distributed by area, for two uniforms a, b and a third c that picks a
 // face; returns the position and the outward normal. The ground is not sampled here (it is infinite in
 // effect; the point sampler draws it on a disc).
@@ -48,5 +51,16 @@ struct SurfaceSample {
 };
 double surface_area(const Primitive& p);
 SurfaceSample sample_surface(const Primitive& p, double a, double b, double c);
+
+// The same surface as faces, each the image of the unit square under a map that is uniform by area and
+// whose two parameters run along orthogonal directions: a box has six faces (-x, +x, -y, +y, -z, +z), a
+// cylinder three (side: a = angle, b = height; bottom and top caps: a = squared radius, b = angle), a sphere
+// one (a = height, b = angle). sample_surface(p, a, b, c) is sample_face(p, f, a, b) with face f picked by
+// c in proportion to area. The ground has no faces.
+int face_count(const Primitive& p);
+double face_area(const Primitive& p, int face);
+SurfaceSample sample_face(const Primitive& p, int face, double a, double b);
+// Typical lengths (metres) of a face along its parameters a and b, to lay out strata of about square shape.
+Vec2<double> face_extent(const Primitive& p, int face);
 
 }  // namespace lumigauss::synth

@@ -32,9 +32,9 @@ std::string header(const MetaInputs& in) {
          "provided. ";
     s += format(
         "Generation parameters: `--scene %s --width %d --height %d --train %d --test %d --seed %llu "
-        "--transients %g --spp-side %d --points %d`.\n\n",
+        "--transients %g --spp-side %d --points %d --gt-surfels %d`.\n\n",
         o.scene.c_str(), o.width, o.height, o.n_train, o.n_test, static_cast<unsigned long long>(o.seed),
-        o.transient_fraction, o.samples_per_side, o.point_candidates);
+        o.transient_fraction, o.samples_per_side, o.point_candidates, o.gt_surfels);
     s += format(
         "* %d training images (%d of them contain random \"pedestrian\" transients), %d test images.\n",
         n_train, n_transient, n_test);
@@ -69,6 +69,10 @@ const char* const kLayoutRows[][2] = {
     {"`gt/sun_visibility/NAME.png`",
      "8-bit gray, fraction of the pixel's samples lit by the sun (surface faces the sun and "
      "the shadow ray is unblocked); 0 for sky. Not in data/plaza"},
+    {"`gt/surfels.ply`",
+     "the static scene (pedestrians excluded) as 2D Gaussian surfels in the 2DGS PLY layout, SH degree 0, "
+     "colour = linear albedo: ground-truth geometry and albedo (see below). Not in data/plaza; absent with "
+     "`--gt-surfels 0`"},
     {"`env/COND.exr`",
      "environment radiance, equirectangular 128x64, float32 OpenEXR (the sky SH in every "
      "pixel, the sun's power in one pixel)"},
@@ -88,6 +92,37 @@ const char* const kLayoutRows[][2] = {
      "(4x4, OpenCV), has_transients, n_transients; conditions (with `sky_sh`, the sky without "
      "the sun); bbox; conventions"},
 };
+
+std::string gt_surfels_section(const MetaInputs& in) {
+    if (!in.gt_surfels || in.gt_surfels->model.size() == 0) return "";
+    const GtSurfels& g = *in.gt_surfels;
+    std::string s = format(
+        "**Ground-truth surfels** (`gt/surfels.ply`): %zu 2D Gaussian surfels (2DGS PLY layout: `x y z`, "
+        "`f_dc_0..2`, `opacity` as a logit, `scale_0 scale_1` as logs, `rot_0..3` a w-first quaternion) "
+        "modelling the static scene's surfaces, about half on the landmark and half on the ground. One "
+        "surfel "
+        "sits at the centre of each cell of a grid laid over each face (cells of equal area, so the surfels "
+        "are uniform by area): %.3f m cells on the landmark's faces; on the ground, rings of %.3f m cells "
+        "within %.1f m of the landmark's centre (every camera is inside) and cells growing with the cube of "
+        "the distance beyond, out to the ground's edge. A cell is kept when some image (train or test) sees "
+        "its centre or a point near one of its corners (facing the camera, in frame, unoccluded by the "
+        "static scene). ",
+        g.model.size(), g.cell, g.ground_cell, g.near_radius);
+    s += format(
+        "Each surfel lies in its surface: the third column of its rotation is the true outward normal, the "
+        "first runs along its cell's first side; its scales are %.2f x its cell's side lengths, so that "
+        "neighbours overlap and surfaces render closed; opacity %.2f. Colour is view-independent (SH degree "
+        "0): the true **linear** albedo averaged over the surfel's cell (%dx%d points), `f_dc = (albedo - "
+        "0.5) "
+        "/ 0.28209479`, i.e. `0.5 + C0 * f_dc = albedo`. So `lumigauss render --ply gt/surfels.ply --scene "
+        "DIR` renders images comparable to `gt/albedo` (linear; black where the sky is), up to texture "
+        "detail finer than the cells and the surfel approximation at geometry edges: at the native "
+        "resolution the rasterizer draws every surfel at least as a 0.7-pixel blob, which widens thin "
+        "features and foreground edges by up to a pixel (render at a multiple of the resolution and "
+        "box-filter down to compare with `gt/albedo`, itself a box-filtered pixel).\n\n",
+        kScalePerCell, kOpacity, kAlbedoSamples, kAlbedoSamples);
+    return s;
+}
 
 std::string conventions(const MetaInputs& in) {
     const Vec3d lo = in.landmark->bbox_lo, hi = in.landmark->bbox_hi;
@@ -158,6 +193,7 @@ Y_lm(d).
         "observations are the exact projections of the noise-free points; ERROR is the resulting RMS "
         "reprojection error in pixels; RGB = mean of the 8-bit training pixels at the observations.\n\n",
         in.n_points, in.noise_sigma, in.scene_diag);
+    s += gt_surfels_section(in);
     s += "**Transients**: 2-5 pedestrians (a cylinder or box body with a sphere head, random colours) stand "
          "between "
          "camera and landmark in some training images only; they cast shadows (not masked) and are included "

@@ -11,6 +11,7 @@
 #include "lumigauss/synth/camera_paths.h"
 #include "lumigauss/synth/colmap_with_tracks.h"
 #include "lumigauss/synth/dataset_writer.h"
+#include "lumigauss/synth/gt_surfels.h"
 #include "lumigauss/synth/pedestrians.h"
 #include "lumigauss/synth/rng.h"
 #include "lumigauss/util/error.h"
@@ -32,6 +33,7 @@ void validate(const SynthOptions& o) {
     require(o.samples_per_side >= 1 && o.samples_per_side <= 16, "samples per side must be in 1..16");
     require(o.point_candidates >= 0, "point candidates must be >= 0");
     require(o.point_noise >= 0, "point noise must be >= 0");
+    require(o.gt_surfels >= 0, "ground-truth surfel count must be >= 0");
 }
 
 // Conditions: about one per three photos, at least two per split (when there are two photos).
@@ -148,17 +150,29 @@ int write_sparse_model(const SynthOptions& o, const Landmark& landmark, const st
     return int(points.size());
 }
 
+// The static scene as ground-truth surfels, fitted to what the photos see; writes gt/surfels.ply.
+GtSurfels write_gt_surfels(const SynthOptions& o, const Landmark& landmark,
+                           const std::vector<Photo>& photos) {
+    std::vector<Camera> cameras;
+    for (const Photo& p : photos) cameras.push_back(p.camera);
+    GtSurfels gt = make_gt_surfels(landmark, cameras, {o.gt_surfels});
+    if (o.gt_surfels > 0) save_2dgs_ply(o.output_dir + "/gt/surfels.ply", gt.model);
+    return gt;
+}
+
 }  // namespace
 
 SynthOptions synth_preset(const std::string& name) {
     SynthOptions o;
     if (name == "tiny") {
         o.width = 64, o.height = 48, o.n_train = 8, o.n_test = 2, o.point_candidates = 1500;
+        o.gt_surfels = 12000;
         o.transient_fraction = 0.25;
     } else if (name == "demo") {
         o.width = 160, o.height = 120, o.n_train = 40, o.n_test = 6, o.point_candidates = 8000;
     } else if (name == "bench") {
         o.width = 320, o.height = 240, o.n_train = 60, o.n_test = 12, o.point_candidates = 30000;
+        o.gt_surfels = 200000;
     } else {
         throw Error("synth: unknown preset '" + name + "' (choose tiny, demo or bench)");
     }
@@ -179,8 +193,9 @@ SynthSummary generate_synthetic_scene(const SynthOptions& o) {
     const double diag = length(landmark.bbox_hi - landmark.bbox_lo);
     const double noise_sigma = o.point_noise * diag / std::sqrt(3.0);  // RMS length = point_noise * diag
     const int n_points = write_sparse_model(o, landmark, photos, training, noise_sigma);
+    const GtSurfels gt = write_gt_surfels(o, landmark, photos);
     write_split_csv(o.output_dir, photos);
-    const MetaInputs meta{&o, &landmark, &photos, &conditions, n_points, noise_sigma, diag};
+    const MetaInputs meta{&o, &landmark, &photos, &conditions, n_points, noise_sigma, diag, &gt};
     write_meta_json(o.output_dir, meta);
     write_readme(o.output_dir, meta);
 
@@ -188,6 +203,7 @@ SynthSummary generate_synthetic_scene(const SynthOptions& o) {
     summary.n_train = o.n_train, summary.n_test = o.n_test;
     summary.n_conditions = int(conditions.size());
     summary.n_points = n_points;
+    summary.n_gt_surfels = int(gt.model.size());
     for (const Photo& p : photos) summary.n_with_transients += p.n_transients > 0;
     summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return summary;

@@ -2,7 +2,8 @@
 // `lumigauss synth`: procedural landmark scenes rendered by a small CPU ray tracer into a dataset in the
 // form real users bring (COLMAP text model, sRGB photos, static-scene masks, split.csv) plus ground truth in
 // the layout and conventions of data/plaza (meta.json, env/COND_sh.txt, gt/{albedo,normal,mask,transient}),
-// so that one evaluation path serves both. The generated README.md states every convention.
+// so that one evaluation path serves both, and the static scene as ground-truth surfels (gt/surfels.ply, the
+// 2DGS PLY layout). The generated README.md states every convention.
 //
 // Deterministic: the same options give byte-identical files, whatever the number of threads.
 #include <cstdint>
@@ -20,6 +21,7 @@ struct SynthOptions {
     int samples_per_side = 2;               // 2 -> 2 x 2 stratified samples per pixel
     int point_candidates = 8000;            // surface samples tried for points3D
     double point_noise = 0.005;             // RMS point position noise, as a fraction of the scene diagonal
+    int gt_surfels = 60000;                 // about this many ground-truth surfels (gt/surfels.ply); 0: none
     bool overwrite = false;                 // replace an existing non-empty output folder's dataset files
     bool verbose = false;                   // progress on stdout
 };
@@ -29,7 +31,7 @@ struct SynthOptions {
 SynthOptions synth_preset(const std::string& name);
 
 struct SynthSummary {
-    int n_train = 0, n_test = 0, n_conditions = 0, n_points = 0, n_with_transients = 0;
+    int n_train = 0, n_test = 0, n_conditions = 0, n_points = 0, n_with_transients = 0, n_gt_surfels = 0;
     double seconds = 0;
 };
 
