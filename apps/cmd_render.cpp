@@ -71,12 +71,13 @@ void run_render(const RenderOptions& o) {
     RasterSettings<float> settings;
     settings.background = o.background;
     int done = 0;
+    RasterState<float> state;  // reused: its buffers and the images' keep their memory from view to view
+    RasterImages<float> img;
     for (const View& v : scene.views) {
         if (o.split != "all" && o.split != split_name(v.split)) continue;
         const auto t0 = std::chrono::steady_clock::now();
         colors_for_view(model, v.camera.center());
-        RasterState<float> state;
-        const RasterImages<float> img = rasterize_forward_cpu(v.camera, model.surfels, settings, state);
+        rasterize_forward_cpu(v.camera, model.surfels, settings, state, img);
         const auto path = output_path(o.out, v.name, ".png");
         std::filesystem::create_directories(path.parent_path());
         write_png(path.string(), color_image(img));

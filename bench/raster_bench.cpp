@@ -63,7 +63,7 @@ void BM_Forward(benchmark::State& state) {
     RasterState<float> st;
     RasterImages<float> img;
     for (auto _ : state) {
-        img = rasterize_forward_cpu(f.cam, f.surfels, RasterSettings<float>{}, st);
+        rasterize_forward_cpu(f.cam, f.surfels, RasterSettings<float>{}, st, img);
         benchmark::DoNotOptimize(img.color.data());
     }
     set_counters(state, st, img);
@@ -93,7 +93,7 @@ void BM_ForwardBackward(benchmark::State& state) {
     RasterImages<float> img;
     RasterImageGrads<float> g;
     for (auto _ : state) {
-        img = rasterize_forward_cpu(f.cam, f.surfels, RasterSettings<float>{}, st);
+        rasterize_forward_cpu(f.cam, f.surfels, RasterSettings<float>{}, st, img);
         g.color.assign(img.color.size(), 0.01f);
         g.alpha.assign(img.alpha.size(), 0.01f);
         auto grads = rasterize_backward_cpu(f.surfels, st, g);

@@ -1,9 +1,7 @@
 #pragma once
 // Helpers for the io tests: a self-deleting temporary folder and small synthetic COLMAP scenes.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
-#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -12,6 +10,7 @@
 #include "lumigauss/io/colmap.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/util/error.h"
+#include "support/temp_dir.h"
 
 namespace lumigauss::test {
 
@@ -23,30 +22,16 @@ inline std::string plaza_dir() {
     return fs::is_directory(dir / "sparse" / "0") ? dir.string() : std::string();
 }
 
-// A fresh folder under the system temp dir, unique per process and test, removed with everything in it.
-class TempDir {
+// A temporary folder named after the running test.
+class TempDir : public lumigauss::testing::TempDir {
   public:
-    TempDir() {
-        static std::atomic<int> counter{0};
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        const std::string test = info ? std::string(info->test_suite_name()) + "_" + info->name() : "none";
-        path_ = fs::temp_directory_path() /
-                ("lumigauss_" + test + "_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-        fs::remove_all(path_);
-        fs::create_directories(path_);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-
-    const fs::path& path() const { return path_; }
-    std::string operator/(const std::string& rel) const { return (path_ / rel).string(); }
+    TempDir() : lumigauss::testing::TempDir(current_test_name()) {}
 
   private:
-    fs::path path_;
+    static std::string current_test_name() {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        return info ? std::string(info->test_suite_name()) + "_" + info->name() : "none";
+    }
 };
 
 // Runs `f` and expects an Error whose message contains every one of `parts` (typically the file name).

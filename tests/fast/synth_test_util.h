@@ -1,9 +1,7 @@
 #pragma once
 // Shared helpers of the Synth* tests: the tiny preset generated into a unique temporary folder (removed
 // afterwards), and small readers for what the project's loaders do not keep (COLMAP tracks, meta.json).
-#include <unistd.h>
 
-#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -13,33 +11,13 @@
 #include <vector>
 
 #include "lumigauss/synth/synth.h"
+#include "support/temp_dir.h"
 
 namespace lumigauss::synth_test {
 
 namespace fs = std::filesystem;
 
-// A fresh folder under the system temp dir, removed with the object.
-class TempDir {
-  public:
-    explicit TempDir(const std::string& tag) {
-        static std::atomic<int> counter{0};
-        path_ = fs::temp_directory_path() /
-                ("lumigauss_" + tag + "_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-        fs::remove_all(path_);
-        fs::create_directories(path_);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-    std::string str() const { return path_.string(); }
-    std::string sub(const std::string& name) const { return (path_ / name).string(); }
-
-  private:
-    fs::path path_;
-};
+using lumigauss::testing::TempDir;
 
 inline synth::SynthOptions tiny_options(const std::string& output_dir) {
     synth::SynthOptions o = synth::synth_preset("tiny");

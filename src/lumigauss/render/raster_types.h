@@ -84,6 +84,10 @@ struct RasterState {
     std::vector<T> m1, m2;                    // per pixel: sum w m, sum w m^2 (distortion)
     std::vector<T> background;
 
+    // Binning scratch, kept so that a loop reusing one RasterState does not allocate it again per call.
+    std::vector<std::uint64_t> sort_keys;
+    std::vector<std::uint32_t> emission_tile, emission_surfel;
+
     std::size_t intersections() const { return entry_surfel.size(); }
 };
 

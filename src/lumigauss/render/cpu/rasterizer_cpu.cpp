@@ -148,6 +148,14 @@ void reduce_surfel_gradients(const SurfelBatch<T>& surfels, const RasterState<T>
 template <typename T>
 RasterImages<T> rasterize_forward_cpu(const Camera& camera, const SurfelBatch<T>& surfels,
                                       const RasterSettings<T>& settings, RasterState<T>& st) {
+    RasterImages<T> img;
+    rasterize_forward_cpu(camera, surfels, settings, st, img);
+    return img;
+}
+
+template <typename T>
+void rasterize_forward_cpu(const Camera& camera, const SurfelBatch<T>& surfels,
+                           const RasterSettings<T>& settings, RasterState<T>& st, RasterImages<T>& img) {
     st.view = pinhole_view<T>(camera);
     st.tiles_x = (camera.width + cpu::kTileSize - 1) / cpu::kTileSize;
     st.tiles_y = (camera.height + cpu::kTileSize - 1) / cpu::kTileSize;
@@ -163,13 +171,11 @@ RasterImages<T> rasterize_forward_cpu(const Camera& camera, const SurfelBatch<T>
     st.median_entry.resize(np);
     st.m1.resize(np);
     st.m2.resize(np);
-    RasterImages<T> img;
     allocate_images(img, camera.width, camera.height, surfels.channels);
     const int num_tiles = st.tiles_x * st.tiles_y;
     tbb::parallel_for(tbb::blocked_range<int>(0, num_tiles, 1), [&](const auto& r) {
         for (int t = r.begin(); t != r.end(); ++t) cpu::forward_tile(t, surfels, st, img);
     });
-    return img;
 }
 
 template <typename T>
@@ -179,10 +185,11 @@ SurfelGrads<T> rasterize_backward_cpu(const SurfelBatch<T>& surfels, const Raste
     const std::size_t n = surfels.size();
     const int stride = cpu::SlotLayout::stride(surfels.channels);
     // Every slot is written by its tile (zeros for entries no pixel reached), so no clearing here.
-    const std::unique_ptr<T[]> slots(new T[st.intersections() * std::size_t(stride)]);
+    const std::unique_ptr<T[]> slot_buffer(new T[st.intersections() * std::size_t(stride)]);
+    T* slots = slot_buffer.get();
     const int num_tiles = st.tiles_x * st.tiles_y;
     tbb::parallel_for(tbb::blocked_range<int>(0, num_tiles, 1), [&](const auto& r) {
-        for (int t = r.begin(); t != r.end(); ++t) cpu::backward_tile(t, surfels, st, grads, slots.get());
+        for (int t = r.begin(); t != r.end(); ++t) cpu::backward_tile(t, surfels, st, grads, slots);
     });
     SurfelGrads<T> out;
     out.means.assign(3 * n, T(0));
@@ -191,7 +198,7 @@ SurfelGrads<T> rasterize_backward_cpu(const SurfelBatch<T>& surfels, const Raste
     out.opacities.assign(n, T(0));
     out.colors.assign(n * surfels.channels, T(0));
     out.mean2d.assign(2 * n, T(0));
-    reduce_surfel_gradients(surfels, st, slots.get(), out);
+    reduce_surfel_gradients(surfels, st, slots, out);
     return out;
 }
 
@@ -199,6 +206,10 @@ template RasterImages<float> rasterize_forward_cpu(const Camera&, const SurfelBa
                                                    const RasterSettings<float>&, RasterState<float>&);
 template RasterImages<double> rasterize_forward_cpu(const Camera&, const SurfelBatch<double>&,
                                                     const RasterSettings<double>&, RasterState<double>&);
+template void rasterize_forward_cpu(const Camera&, const SurfelBatch<float>&, const RasterSettings<float>&,
+                                    RasterState<float>&, RasterImages<float>&);
+template void rasterize_forward_cpu(const Camera&, const SurfelBatch<double>&, const RasterSettings<double>&,
+                                    RasterState<double>&, RasterImages<double>&);
 template SurfelGrads<float> rasterize_backward_cpu(const SurfelBatch<float>&, const RasterState<float>&,
                                                    const RasterImageGrads<float>&);
 template SurfelGrads<double> rasterize_backward_cpu(const SurfelBatch<double>&, const RasterState<double>&,

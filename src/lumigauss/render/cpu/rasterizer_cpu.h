@@ -17,6 +17,11 @@ template <typename T>
 RasterImages<T> rasterize_forward_cpu(const Camera& camera, const SurfelBatch<T>& surfels,
                                       const RasterSettings<T>& settings, RasterState<T>& state);
 
+// The same, into caller-owned images whose buffers are reused from call to call (loops over views).
+template <typename T>
+void rasterize_forward_cpu(const Camera& camera, const SurfelBatch<T>& surfels,
+                           const RasterSettings<T>& settings, RasterState<T>& state, RasterImages<T>& images);
+
 template <typename T>
 SurfelGrads<T> rasterize_backward_cpu(const SurfelBatch<T>& surfels, const RasterState<T>& state,
                                       const RasterImageGrads<T>& grads);

@@ -35,7 +35,8 @@ void bin_surfels_to_tiles(RasterState<T>& st) {
     const std::size_t total = st.emission_offset[n];
     const std::size_t num_tiles = std::size_t(st.tiles_x) * st.tiles_y;
 
-    std::vector<std::uint32_t> emission_tile(total);
+    std::vector<std::uint32_t>& emission_tile = st.emission_tile;
+    emission_tile.resize(total);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             if (!st.visible[i]) continue;
@@ -53,11 +54,13 @@ void bin_surfels_to_tiles(RasterState<T>& st) {
 
     // Scatter the emissions into tile order as sort keys: the depth's float bits (positive floats order like
     // their bit patterns) above the emission index, which breaks ties deterministically, in surfel order.
-    std::vector<std::uint32_t> emission_surfel(total);
+    std::vector<std::uint32_t>& emission_surfel = st.emission_surfel;
+    emission_surfel.resize(total);
     for (std::size_t i = 0; i < n; ++i)
         std::fill(emission_surfel.begin() + st.emission_offset[i],
                   emission_surfel.begin() + st.emission_offset[i + 1], std::uint32_t(i));
-    std::vector<std::uint64_t> keys(total);
+    std::vector<std::uint64_t>& keys = st.sort_keys;
+    keys.resize(total);
     {
         std::vector<std::uint32_t> cursor(st.tile_start.begin(), st.tile_start.end() - 1);
         for (std::uint32_t e = 0; e < total; ++e) {
