@@ -11,7 +11,7 @@ scripts/setup.sh
 bin=build/lumigauss
 
 echo "== 1/3 generating the synthetic scene (demo preset) in $out/scene"
-"$bin" synth --preset demo -o "$out/scene" --overwrite
+"$bin" synth --preset demo -o "$out/scene" --force
 echo "== 2/3 what the loader sees"
 "$bin" info "$out/scene"
 echo "== 3/3 rendering the ground-truth surfel model of the scene from every camera"
