@@ -1,0 +1,147 @@
+#pragma once
+// The trainable surfel model of the official LumiGauss (`scene/gaussian_model.py:GaussianModel`), as raw
+// (pre-activation) parameters in structure-of-arrays form, each attribute with its own Adam group, plus the
+// densification bookkeeping (research/lumigauss_official.md 2.1, 5; research/2dgs_rasterizer.md 6).
+//
+// Official tensors and their storage here (row-major float, one row per surfel):
+//   _xyz                      N x 3         xyz        identity
+//   _rotation                 N x 4         rotation   raw quaternion w x y z (normalised where used)
+//   _scaling                  N x 2         scaling    log s_u, log s_v (activation exp)
+//   _opacity                  N x 1         opacity    logit (activation sigmoid)
+//   _albedo                   N x 3         albedo     raw; colour max(0, Y00 a + 0.5) (surfel_shading.h)
+//   _features_dc_positive     N x 1 x 3  \  transfer_positive N x 27, the torch memory order of
+//   _features_rest_positive   N x 8 x 3  /  cat((dc, rest), 1): [k * 3 + c], k = SH coefficient, c = channel
+//   _features_dc/rest_negative            transfer_negative N x 27, same
+// Only channel 0 of a transfer set is ever read (2.1): transfer_channel0() gives those 9 scalars.
+// The official code has separate Adam groups for f_dc_* and f_rest_*; with one learning rate for both and
+// both always receiving gradients together, one group of 27 per side is element-for-element identical.
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "lumigauss/math/vec.h"
+#include "lumigauss/render/raster_types.h"
+#include "lumigauss/train/adam.h"
+
+namespace lumigauss {
+
+enum class ModelParam { Xyz, Rotation, Scaling, Opacity, Albedo, TransferPositive, TransferNegative };
+inline constexpr int kModelParamCount = 7;
+inline constexpr int kTransferCoeffs = 9;                    // SH degree 2
+inline constexpr int kTransferStored = 3 * kTransferCoeffs;  // 27 floats per side as stored officially
+
+// Official defaults (training_setup, 5): xyz decays 1.6e-4 -> 1.6e-6 (x spatial_lr_scale) over 30000 steps.
+struct ModelLearningRates {
+    double position_init = 1.6e-4;
+    double position_final = 1.6e-6;
+    double position_delay_mult = 0.01;  // inert: delay steps are 0
+    std::int64_t position_max_steps = 30000;
+    double transfer = 0.002;  // f_dc and f_rest, positive and negative (rest not divided by 20)
+    double opacity = 0.05;
+    double scaling = 0.005;
+    double rotation = 0.001;
+    double albedo = 0.0025;
+};
+
+// Official densification thresholds (5): grad 2e-4, percent_dense 0.01, min opacity 0.05, 20 px, 0.1 extent.
+struct DensifyOptions {
+    double percent_dense = 0.01;
+    double world_size_fraction = 0.1;  // prune max scale > 0.1 * extent (only with a screen-size limit)
+    int split_children = 2;
+    // The official densification_postfix zeroes max_radii2D before the prune reads it, so the screen-size
+    // rule never fires; true replicates that, false prunes by the radii accumulated since the last reset.
+    bool faithful_radii_reset = true;
+};
+
+struct DensifyReport {
+    std::size_t cloned = 0, split = 0, pruned = 0;
+};
+
+class GaussianModel {
+  public:
+    static int width(ModelParam p);
+    static const char* name(ModelParam p);  // the official optimizer group name (transfer: "f_positive"...)
+
+    GaussianModel() = default;
+
+    // create_from_pcd + training_setup. point_rgb in [0, 1]. spatial_lr_scale = cameras_extent.
+    static GaussianModel from_points(const std::vector<Vec3f>& xyz, const std::vector<Vec3f>& rgb,
+                                     double spatial_lr_scale, std::uint64_t seed,
+                                     const ModelLearningRates& lr = {});
+    // Wraps existing raw parameters (e.g. a loaded PLY) with fresh optimizer state. Every vector must hold
+    // size * width(p) floats.
+    static GaussianModel from_raw(std::vector<std::vector<float>> raw, double spatial_lr_scale,
+                                  const ModelLearningRates& lr = {});
+
+    std::size_t size() const { return params_[0].size() / 3; }
+    std::vector<float>& param(ModelParam p) { return params_[int(p)]; }
+    const std::vector<float>& param(ModelParam p) const { return params_[int(p)]; }
+    AdamGroup& adam(ModelParam p) { return adam_[int(p)]; }
+    const AdamGroup& adam(ModelParam p) const { return adam_[int(p)]; }
+    // The gradient buffer of a group; asking for it mutably marks the group as having a gradient this
+    // iteration (torch zero_grad(set_to_none=True): groups without a gradient are not stepped).
+    std::span<float> grad(ModelParam p);
+    std::span<const float> grad(ModelParam p) const { return grads_[int(p)]; }
+    bool has_grad(ModelParam p) const { return has_grad_[int(p)]; }
+    const ModelLearningRates& learning_rates() const { return lr_; }
+    double spatial_lr_scale() const { return spatial_lr_scale_; }
+
+    // Channel 0 of surfel i's transfer set: 9 scalars (the only ones the official shading reads).
+    void transfer_channel0(bool positive, std::size_t i, float out[kTransferCoeffs]) const;
+
+    // Geometry and opacity as the rasterizer takes them (exp scales, sigmoid opacity, raw quaternions).
+    // Colours are left to the caller: batch.colors is resized to batch.channels per surfel, not written.
+    void activated(SurfelBatch<float>& batch) const;
+    // Chain rule from activated-value gradients into the raw-gradient buffers (added). Empty vectors in
+    // `g` are skipped; colour and mean2d entries are not used here.
+    void accumulate_grads_from_activated(const SurfelGrads<float>& g);
+
+    void zero_grad();
+    // One Adam step on every group that received a gradient; the xyz learning rate first follows the
+    // exponential schedule at `iteration` (update_learning_rate).
+    void step(std::int64_t iteration);
+    double position_lr(std::int64_t iteration) const;
+
+    // Densification statistics (add_densification_stats plus the max_radii2D update of train.py), for one
+    // rendered view: for each visible surfel, accum += |(g_x W/2, g_y H/2)| (mean2d in pixels -> NDC units),
+    // count += 1, max_radius = max(max_radius, radius).
+    void add_densification_stats(std::span<const float> mean2d_grad, std::span<const std::uint8_t> visible,
+                                 std::span<const float> radii, int image_width, int image_height);
+    const std::vector<float>& grad_accum() const { return grad_accum_; }
+    const std::vector<float>& grad_count() const { return grad_count_; }
+    const std::vector<float>& max_radii() const { return max_radii_; }
+
+    // densify_and_clone, densify_and_split, then prune (2DGS densify_and_prune). max_screen_size <= 0
+    // disables the screen/world-size rules (the official passes None before iteration 3000).
+    DensifyReport densify_and_prune(double grad_threshold, double min_opacity, double extent,
+                                    double max_screen_size, std::uint64_t seed,
+                                    const DensifyOptions& opt = {});
+    // opacity <- min(opacity, 0.01) (as logit), opacity moments zeroed (replace_tensor_to_optimizer).
+    void reset_opacity();
+    // Keeps rows with keep[i] != 0 in every parameter, gradient, Adam state and statistic.
+    void keep_rows(std::span<const std::uint8_t> keep);
+
+  private:
+    void init_optimizer(const ModelLearningRates& lr, double spatial_lr_scale);
+    // densification_postfix: appends rows (copies of the given raw values), zero moments, stats reset.
+    void append_rows(const std::vector<std::vector<float>>& rows, bool reset_radii);
+    void reset_stats();
+    std::size_t clone(const std::vector<float>& grads, double threshold, double extent, double percent_dense,
+                      bool reset_radii);
+    std::size_t split(const std::vector<float>& grads, double threshold, double extent, double percent_dense,
+                      int children, std::uint64_t seed, bool reset_radii);
+
+    std::vector<float> params_[kModelParamCount];
+    std::vector<float> grads_[kModelParamCount];
+    bool has_grad_[kModelParamCount]{};
+    AdamGroup adam_[kModelParamCount];
+    ExponLrSchedule xyz_schedule_;
+    ModelLearningRates lr_;
+    double spatial_lr_scale_ = 1;
+    std::vector<float> grad_accum_, grad_count_, max_radii_;  // xyz_gradient_accum, denom, max_radii2D
+};
+
+float inverse_sigmoid(float p);
+
+}  // namespace lumigauss
