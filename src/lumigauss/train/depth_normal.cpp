@@ -1,13 +1,11 @@
 #include "lumigauss/train/depth_normal.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
 
+#include "lumigauss/train/row_parallel.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {
@@ -20,20 +18,8 @@ void require(bool ok, const char* what) {
     if (!ok) throw Error(std::string("depth/normal loss: ") + what);
 }
 
-// Rows are independent and each output is written by one row, so results do not depend on the split.
-template <typename F>
-void for_each_row(int height, F&& f) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
-        for (int y = r.begin(); y < r.end(); ++y) f(y);
-    });
-}
-
-template <typename T>
-T sum_in_order(const std::vector<T>& parts) {
-    T s = 0;
-    for (T v : parts) s += v;
-    return s;
-}
+using train_detail::for_each_row;
+using train_detail::sum_in_order;
 
 template <typename T>
 Vec3<T> load3(std::span<const T> v, std::size_t p) {

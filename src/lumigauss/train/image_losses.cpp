@@ -1,13 +1,11 @@
 #include "lumigauss/train/image_losses.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <array>
 #include <cmath>
 #include <string>
 #include <vector>
 
+#include "lumigauss/train/row_parallel.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {
@@ -24,22 +22,8 @@ void require(bool ok, const char* what) {
     if (!ok) throw Error(std::string("image loss: ") + what);
 }
 
-// Rows are independent in every pass below and each output is summed in a fixed order, so the results do
-// not depend on how TBB splits the rows.
-template <typename F>
-void for_each_row(int height, F&& f) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
-        for (int y = r.begin(); y < r.end(); ++y) f(y);
-    });
-}
-
-// Sums per-row partial sums serially, so that the total is deterministic.
-template <typename T>
-T sum_in_order(const std::vector<T>& parts) {
-    T s = 0;
-    for (T v : parts) s += v;
-    return s;
-}
+using train_detail::for_each_row;
+using train_detail::sum_in_order;
 
 template <typename T>
 void check_inputs(const ImageShape& shape, std::span<const T> rendered, std::span<const T> target,
