@@ -125,10 +125,10 @@ TEST(SynthPrimitives, LookAtAndQuaternionRoundTrip) {
     // Rows: camera x (right), y (down), z (forward) in world coordinates.
     EXPECT_NEAR(dot(r.row(2), normalize(target - eye)), 1.0, 1e-12);
     EXPECT_GT(dot(r.row(1), Vec3d{0, 0, -1}), 0.9);  // image down is world down
-    const Mat3d back = rotation_from_unit_quaternion(synth::quaternion_from_rotation(r));
+    const Mat3d back = rotation_from_unit_quaternion(quaternion_from_rotation(r));
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) EXPECT_NEAR(back(i, j), r(i, j), 1e-12);
-    const Vec4<double> q = synth::quaternion_from_rotation(r);
+    const Vec4<double> q = quaternion_from_rotation(r);
     EXPECT_GE(q.x, 0.0);
 }
 

@@ -1,6 +1,5 @@
 #include "lumigauss/synth/colmap_with_tracks.h"
 
-#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -98,27 +97,6 @@ std::string points3d_txt(const std::vector<ColmapView>& views, const std::vector
 }
 
 }  // namespace
-
-Vec4<double> quaternion_from_rotation(const Mat3d& r) {
-    // Shepperd's method: pivot on the largest of w, x, y, z for accuracy.
-    const double tr = r(0, 0) + r(1, 1) + r(2, 2);
-    Vec4<double> q;  // w, x, y, z in .x .y .z .w
-    if (tr > 0) {
-        const double s = 2 * std::sqrt(1 + tr);
-        q = {0.25 * s, (r(2, 1) - r(1, 2)) / s, (r(0, 2) - r(2, 0)) / s, (r(1, 0) - r(0, 1)) / s};
-    } else if (r(0, 0) > r(1, 1) && r(0, 0) > r(2, 2)) {
-        const double s = 2 * std::sqrt(1 + r(0, 0) - r(1, 1) - r(2, 2));
-        q = {(r(2, 1) - r(1, 2)) / s, 0.25 * s, (r(0, 1) + r(1, 0)) / s, (r(0, 2) + r(2, 0)) / s};
-    } else if (r(1, 1) > r(2, 2)) {
-        const double s = 2 * std::sqrt(1 + r(1, 1) - r(0, 0) - r(2, 2));
-        q = {(r(0, 2) - r(2, 0)) / s, (r(0, 1) + r(1, 0)) / s, 0.25 * s, (r(1, 2) + r(2, 1)) / s};
-    } else {
-        const double s = 2 * std::sqrt(1 + r(2, 2) - r(0, 0) - r(1, 1));
-        q = {(r(1, 0) - r(0, 1)) / s, (r(0, 2) + r(2, 0)) / s, (r(1, 2) + r(2, 1)) / s, 0.25 * s};
-    }
-    if (q.x < 0) q = {-q.x, -q.y, -q.z, -q.w};
-    return normalize_quaternion(q);
-}
 
 void write_colmap_with_tracks(const std::string& dir, const std::vector<ColmapView>& views,
                               const std::vector<SfmPoint>& points) {

@@ -21,7 +21,4 @@ struct ColmapView {
 void write_colmap_with_tracks(const std::string& dir, const std::vector<ColmapView>& views,
                               const std::vector<SfmPoint>& points);
 
-// Unit quaternion (w, x, y, z), w >= 0, of a rotation matrix (Hamilton, as COLMAP).
-Vec4<double> quaternion_from_rotation(const Mat3d& r);
-
 }  // namespace lumigauss::synth
