@@ -1,0 +1,494 @@
+// TrainConfig presets, JSON and --set parsing, validation. Every field is listed once, in kFields below;
+// writing, reading, overriding and validating all go through that table, and a static_assert ties its length
+// to the number of members of TrainConfig so that a new field cannot be forgotten.
+#include "lumigauss/train/train_config.h"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "lumigauss/util/error.h"
+
+namespace lumigauss {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+// ---- The field table
+// ----------------------------------------------------------------------------------------
+
+using FieldPtr = std::variant<std::string TrainConfig::*, std::uint64_t TrainConfig::*, int TrainConfig::*,
+                              std::int64_t TrainConfig::*, double TrainConfig::*, bool TrainConfig::*>;
+
+struct Field {
+    std::string_view name;
+    FieldPtr ptr;
+};
+
+#define LUMIGAUSS_FIELD(member)       \
+    Field {                           \
+#member, &TrainConfig::member \
+    }
+
+constexpr std::array kFields = {
+    LUMIGAUSS_FIELD(preset),
+    LUMIGAUSS_FIELD(seed),
+    LUMIGAUSS_FIELD(downscale),
+    LUMIGAUSS_FIELD(iterations),
+    LUMIGAUSS_FIELD(warmup),
+    LUMIGAUSS_FIELD(start_shadowed),
+    LUMIGAUSS_FIELD(start_regularization),
+    LUMIGAUSS_FIELD(lambda_dssim),
+    LUMIGAUSS_FIELD(lambda_unshadowed_stage3),
+    LUMIGAUSS_FIELD(lambda_range01),
+    LUMIGAUSS_FIELD(lambda_env),
+    LUMIGAUSS_FIELD(lambda_consistency),
+    LUMIGAUSS_FIELD(lambda_shadow),
+    LUMIGAUSS_FIELD(lambda_normal),
+    LUMIGAUSS_FIELD(lambda_distortion),
+    LUMIGAUSS_FIELD(env_noise_sigma),
+    LUMIGAUSS_FIELD(transfer_samples),
+    LUMIGAUSS_FIELD(env_samples),
+    LUMIGAUSS_FIELD(lr_position_init),
+    LUMIGAUSS_FIELD(lr_position_final),
+    LUMIGAUSS_FIELD(lr_position_max_steps),
+    LUMIGAUSS_FIELD(lr_transfer),
+    LUMIGAUSS_FIELD(lr_opacity),
+    LUMIGAUSS_FIELD(lr_scaling),
+    LUMIGAUSS_FIELD(lr_rotation),
+    LUMIGAUSS_FIELD(lr_albedo),
+    LUMIGAUSS_FIELD(lr_embedding),
+    LUMIGAUSS_FIELD(lr_mlp),
+    LUMIGAUSS_FIELD(lr_env_final_ratio),
+    LUMIGAUSS_FIELD(densify_from),
+    LUMIGAUSS_FIELD(densify_until),
+    LUMIGAUSS_FIELD(densify_interval),
+    LUMIGAUSS_FIELD(opacity_reset_interval),
+    LUMIGAUSS_FIELD(densify_grad_threshold),
+    LUMIGAUSS_FIELD(min_opacity),
+    LUMIGAUSS_FIELD(max_screen_size),
+    LUMIGAUSS_FIELD(percent_dense),
+    LUMIGAUSS_FIELD(faithful_radii_reset),
+    LUMIGAUSS_FIELD(checkpoint_interval),
+    LUMIGAUSS_FIELD(log_interval),
+};
+
+#undef LUMIGAUSS_FIELD
+
+// Number of members of an aggregate: the largest N for which T{x1, ..., xN} compiles with x convertible to
+// anything (TrainConfig has no base class and no nested aggregate, so brace elision cannot inflate it).
+struct AnyValue {
+    template <class T>
+    constexpr operator T() const noexcept;  // declared only: used in unevaluated contexts
+};
+
+template <class T, std::size_t... I>
+constexpr bool brace_initializable_with(std::index_sequence<I...> /*unused*/) {
+    return requires {
+        T{(static_cast<void>(I), AnyValue{})...};
+    };
+}
+
+template <class T, std::size_t N = 0>
+constexpr std::size_t aggregate_member_count() {
+    if constexpr (brace_initializable_with<T>(std::make_index_sequence<N + 1>{})) {
+        return aggregate_member_count<T, N + 1>();
+    } else {
+        return N;
+    }
+}
+
+static_assert(kFields.size() == aggregate_member_count<TrainConfig>(),
+              "kFields must list every member of TrainConfig exactly once");
+
+const Field* find_field(std::string_view name) {
+    for (const Field& f : kFields) {
+        if (f.name == name) return &f;
+    }
+    return nullptr;
+}
+
+// ---- Messages
+// -----------------------------------------------------------------------------------------------
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        std::size_t diagonal = row[0];
+        row[0] = i;
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            const std::size_t above = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0u : 1u)});
+            diagonal = above;
+        }
+    }
+    return row[b.size()];
+}
+
+std::string unknown_key_message(std::string_view source, std::string_view key) {
+    std::string message = std::string(source) + ": unknown key '" + std::string(key) + "'";
+    std::string_view best;
+    std::size_t best_distance = std::numeric_limits<std::size_t>::max();
+    for (const Field& f : kFields) {
+        const std::size_t d = edit_distance(key, f.name);
+        if (d < best_distance) {
+            best_distance = d;
+            best = f.name;
+        }
+    }
+    const bool is_part = key.size() >= 4 && best.find(key) != std::string_view::npos;
+    if (best_distance <= std::max<std::size_t>(2, key.size() / 4) || is_part) {
+        message += " (did you mean '" + std::string(best) + "'?)";
+    } else {
+        message += " (see the config.json a run writes for every key)";
+    }
+    return message;
+}
+
+std::string format_double(double v) {
+    std::array<char, 64> buf{};
+    const auto [end, ec] = std::to_chars(buf.data(), buf.data() + buf.size(), v);
+    return ec == std::errc() ? std::string(buf.data(), end) : std::string("?");
+}
+
+template <class Field_t>
+std::string format_value(Field_t v) {
+    if constexpr (std::is_same_v<Field_t, double>) {
+        return format_double(v);
+    } else if constexpr (std::is_same_v<Field_t, bool>) {
+        return v ? "true" : "false";
+    } else {
+        return std::to_string(v);
+    }
+}
+
+template <class Field_t>
+constexpr std::string_view expected_type() {
+    if constexpr (std::is_same_v<Field_t, std::string>) {
+        return "a string";
+    } else if constexpr (std::is_same_v<Field_t, bool>) {
+        return "a boolean (true or false)";
+    } else if constexpr (std::is_same_v<Field_t, double>) {
+        return "a finite number";
+    } else if constexpr (std::is_same_v<Field_t, std::uint64_t>) {
+        return "a non-negative integer";
+    } else if constexpr (std::is_same_v<Field_t, int>) {
+        return "an integer (32-bit)";
+    } else {
+        return "an integer";
+    }
+}
+
+[[noreturn]] void wrong_type(std::string_view source, std::string_view key, std::string_view expected,
+                             const std::string& got) {
+    throw Error(std::string(source) + ": key '" + std::string(key) + "' expects " + std::string(expected) +
+                ", got " + got);
+}
+
+// ---- JSON values
+// --------------------------------------------------------------------------------------------
+
+// An exact integer held by a JSON number in [lo, hi]: integers, and floats with an integral value (3.0, 3e4).
+template <class Int>
+bool json_to_integer(const Json& j, Int& out) {
+    constexpr Int lo = std::numeric_limits<Int>::min();
+    constexpr Int hi = std::numeric_limits<Int>::max();
+    if (j.is_number_unsigned()) {
+        const auto v = j.get<std::uint64_t>();
+        if (v > static_cast<std::uint64_t>(hi)) return false;
+        out = static_cast<Int>(v);
+        return true;
+    }
+    if (j.is_number_integer()) {
+        const auto v = j.get<std::int64_t>();
+        if constexpr (std::is_signed_v<Int>) {
+            if (v < static_cast<std::int64_t>(lo) || v > static_cast<std::int64_t>(hi)) return false;
+        } else {
+            if (v < 0) return false;
+        }
+        out = static_cast<Int>(v);
+        return true;
+    }
+    if (j.is_number_float()) {
+        const double v = j.get<double>();
+        // 2^63 and 2^64 are exact doubles; [lo, hi + 1) is the representable range of Int.
+        const double lo_d = static_cast<double>(lo);
+        const double hi_plus_1 = std::ldexp(1.0, std::numeric_limits<Int>::digits);
+        if (!std::isfinite(v) || v != std::floor(v) || v < lo_d || v >= hi_plus_1) return false;
+        out = static_cast<Int>(v);
+        return true;
+    }
+    return false;
+}
+
+void set_from_json(TrainConfig& config, const Field& field, const Json& value, std::string_view source) {
+    std::visit(
+        [&](auto member) {
+            using Field_t = std::remove_reference_t<decltype(config.*member)>;
+            auto& target = config.*member;
+            bool ok = false;
+            if constexpr (std::is_same_v<Field_t, std::string>) {
+                if (value.is_string()) {
+                    target = value.get<std::string>();
+                    ok = true;
+                }
+            } else if constexpr (std::is_same_v<Field_t, bool>) {
+                if (value.is_boolean()) {
+                    target = value.get<bool>();
+                    ok = true;
+                }
+            } else if constexpr (std::is_same_v<Field_t, double>) {
+                if (value.is_number()) {
+                    target = value.get<double>();
+                    ok = std::isfinite(target);
+                }
+            } else {
+                ok = json_to_integer(value, target);
+            }
+            if (!ok) wrong_type(source, field.name, expected_type<Field_t>(), value.dump());
+        },
+        field.ptr);
+}
+
+// ---- Text values (--set)
+// ------------------------------------------------------------------------------------
+
+std::string_view trim(std::string_view s) {
+    constexpr std::string_view kSpace = " \t\r\n";
+    const std::size_t first = s.find_first_not_of(kSpace);
+    if (first == std::string_view::npos) return {};
+    const std::size_t last = s.find_last_not_of(kSpace);
+    return s.substr(first, last - first + 1);
+}
+
+template <class Number>
+bool parse_number(std::string_view text, Number& out) {
+    // from_chars rejects a leading '+', which people write; accept exactly one.
+    if (text.size() > 1 && text.front() == '+' && text[1] != '-' && text[1] != '+') text.remove_prefix(1);
+    if (text.empty()) return false;
+    Number v{};
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (ec != std::errc() || end != text.data() + text.size()) return false;
+    if constexpr (std::is_floating_point_v<Number>) {
+        if (!std::isfinite(v)) return false;
+    }
+    out = v;
+    return true;
+}
+
+void set_from_text(TrainConfig& config, const Field& field, std::string_view text, std::string_view source) {
+    std::visit(
+        [&](auto member) {
+            using Field_t = std::remove_reference_t<decltype(config.*member)>;
+            auto& target = config.*member;
+            bool ok = false;
+            if constexpr (std::is_same_v<Field_t, std::string>) {
+                target = std::string(text);
+                ok = true;
+            } else if constexpr (std::is_same_v<Field_t, bool>) {
+                if (text == "true" || text == "1") {
+                    target = true;
+                    ok = true;
+                } else if (text == "false" || text == "0") {
+                    target = false;
+                    ok = true;
+                }
+            } else {
+                ok = parse_number(text, target);
+            }
+            if (!ok) {
+                const std::string_view expected = std::is_same_v<Field_t, bool>
+                                                      ? std::string_view("true, false, 1 or 0")
+                                                      : expected_type<Field_t>();
+                wrong_type(source, field.name, expected, "'" + std::string(text) + "'");
+            }
+        },
+        field.ptr);
+}
+
+TrainConfig preset_for_key(std::string_view name, std::string_view source) {
+    try {
+        return train_preset(name);
+    } catch (const Error& e) {
+        throw Error(std::string(source) + ": key 'preset': " + e.what());
+    }
+}
+
+// ---- Validation
+// ---------------------------------------------------------------------------------------------
+
+[[noreturn]] void invalid(std::string_view key, const std::string& value, std::string_view rule) {
+    throw Error("invalid train config: " + std::string(key) + " = " + value + " (" + std::string(rule) + ")");
+}
+
+template <class T>
+void require(bool ok, std::string_view key, T value, std::string_view rule) {
+    if (!ok) invalid(key, format_value(value), rule);
+}
+
+}  // namespace
+
+TrainConfig train_preset(std::string_view name) {
+    TrainConfig config;  // "paper": the struct's defaults are the official values
+    if (name == "paper") return config;
+    if (name == "fast") {
+        // Small synthetic scenes in a few minutes on 2 cores: the schedule shrunk ~13x, losses and rates
+        // kept.
+        config.preset = "fast";
+        config.iterations = 3000;
+        config.warmup = 1500;
+        config.start_shadowed = 1600;
+        config.start_regularization = 500;
+        config.lr_position_max_steps = 2250;
+        config.densify_from = 100;
+        config.densify_until = 1200;
+        config.densify_interval = 100;
+        config.opacity_reset_interval = 600;
+        config.checkpoint_interval = 500;
+        return config;
+    }
+    throw Error("unknown training preset '" + std::string(name) + "' (valid presets: paper, fast)");
+}
+
+std::string train_config_to_json(const TrainConfig& config) {
+    Json j = Json::object();
+    for (const Field& f : kFields) {
+        std::visit([&](auto member) { j[std::string(f.name)] = config.*member; }, f.ptr);
+    }
+    return j.dump(2) + "\n";
+}
+
+void apply_train_config_json(TrainConfig& config, std::string_view json_text, std::string_view source) {
+    Json j;
+    try {
+        j = Json::parse(json_text.begin(), json_text.end());
+    } catch (const Json::parse_error& e) {
+        throw Error(std::string(source) + ": not valid JSON: " + e.what());
+    }
+    if (!j.is_object()) {
+        throw Error(std::string(source) + ": expected a JSON object of training settings, got " +
+                    std::string(j.type_name()));
+    }
+    TrainConfig result = config;  // all or nothing: `config` is untouched when a key fails
+    if (const auto it = j.find("preset"); it != j.end()) {
+        if (!it->is_string()) wrong_type(source, "preset", "a string (paper or fast)", it->dump());
+        result = preset_for_key(it->get<std::string>(), source);
+    }
+    for (const auto& item : j.items()) {
+        if (item.key() == "preset") continue;
+        const Field* field = find_field(item.key());
+        if (field == nullptr) throw Error(unknown_key_message(source, item.key()));
+        set_from_json(result, *field, item.value(), source);
+    }
+    config = std::move(result);
+}
+
+void apply_train_config_override(TrainConfig& config, std::string_view key_equals_value) {
+    const std::string source = "--set " + std::string(key_equals_value);
+    const std::size_t eq = key_equals_value.find('=');
+    if (eq == std::string_view::npos) {
+        throw Error(source + ": expected key=value (for example --set iterations=3000)");
+    }
+    const std::string_view key = trim(key_equals_value.substr(0, eq));
+    const std::string_view value = trim(key_equals_value.substr(eq + 1));
+    if (key.empty()) throw Error(source + ": expected key=value, the key is empty");
+    if (key == "preset") {
+        config = preset_for_key(value, source);
+        return;
+    }
+    const Field* field = find_field(key);
+    if (field == nullptr) throw Error(unknown_key_message(source, key));
+    TrainConfig result = config;
+    set_from_text(result, *field, value, source);
+    config = std::move(result);
+}
+
+void validate_train_config(const TrainConfig& c) {
+    // Every double must be finite (JSON and --set cannot produce NaN or infinity, code can).
+    for (const Field& f : kFields) {
+        if (const auto* member = std::get_if<double TrainConfig::*>(&f.ptr)) {
+            require(std::isfinite(c.**member), f.name, c.**member, "must be finite");
+        }
+    }
+
+    require(c.downscale == 1 || c.downscale == 2 || c.downscale == 4 || c.downscale == 8, "downscale",
+            c.downscale, "must be 1, 2, 4 or 8");
+
+    // Schedule. start_shadowed > iterations (no stage 3) and warmup > iterations (stage 1 only) are allowed.
+    require(c.iterations > 0, "iterations", c.iterations, "must be > 0");
+    require(c.warmup >= 1, "warmup", c.warmup, "must be >= 1");
+    if (c.warmup > c.start_shadowed) {
+        invalid("warmup", std::to_string(c.warmup),
+                "must be <= start_shadowed = " + std::to_string(c.start_shadowed));
+    }
+    require(c.start_regularization >= 0, "start_regularization", c.start_regularization, "must be >= 0");
+
+    // Loss weights, noise, Monte Carlo.
+    const std::array<std::pair<std::string_view, double>, 9> non_negative = {{
+        {"lambda_dssim", c.lambda_dssim},
+        {"lambda_unshadowed_stage3", c.lambda_unshadowed_stage3},
+        {"lambda_range01", c.lambda_range01},
+        {"lambda_env", c.lambda_env},
+        {"lambda_consistency", c.lambda_consistency},
+        {"lambda_shadow", c.lambda_shadow},
+        {"lambda_normal", c.lambda_normal},
+        {"lambda_distortion", c.lambda_distortion},
+        {"env_noise_sigma", c.env_noise_sigma},
+    }};
+    for (const auto& [key, value] : non_negative) require(value >= 0.0, key, value, "must be >= 0");
+    require(c.transfer_samples > 0, "transfer_samples", c.transfer_samples, "must be > 0");
+    require(c.env_samples > 0, "env_samples", c.env_samples, "must be > 0");
+
+    // Learning rates. The position schedule is log-linear: both ends > 0, or both 0 (frozen positions).
+    require(c.lr_position_init >= 0.0, "lr_position_init", c.lr_position_init, "must be >= 0");
+    require(c.lr_position_final >= 0.0, "lr_position_final", c.lr_position_final, "must be >= 0");
+    if ((c.lr_position_init == 0.0) != (c.lr_position_final == 0.0)) {
+        const bool init_zero = c.lr_position_init == 0.0;
+        invalid(init_zero ? "lr_position_init" : "lr_position_final",
+                format_double(init_zero ? c.lr_position_init : c.lr_position_final),
+                "the log-linear position schedule needs lr_position_init and lr_position_final both > 0 "
+                "or both 0");
+    }
+    require(c.lr_position_max_steps > 0, "lr_position_max_steps", c.lr_position_max_steps, "must be > 0");
+    const std::array<std::pair<std::string_view, double>, 7> rates = {{
+        {"lr_transfer", c.lr_transfer},
+        {"lr_opacity", c.lr_opacity},
+        {"lr_scaling", c.lr_scaling},
+        {"lr_rotation", c.lr_rotation},
+        {"lr_albedo", c.lr_albedo},
+        {"lr_embedding", c.lr_embedding},
+        {"lr_mlp", c.lr_mlp},
+    }};
+    for (const auto& [key, value] : rates) require(value >= 0.0, key, value, "must be >= 0");
+    require(c.lr_env_final_ratio > 0.0, "lr_env_final_ratio", c.lr_env_final_ratio, "must be > 0");
+
+    // Densification. densify_until < densify_from is allowed (no densification).
+    require(c.densify_from >= 0, "densify_from", c.densify_from, "must be >= 0");
+    require(c.densify_until >= 0, "densify_until", c.densify_until, "must be >= 0");
+    require(c.densify_interval > 0, "densify_interval", c.densify_interval, "must be > 0");
+    require(c.opacity_reset_interval > 0, "opacity_reset_interval", c.opacity_reset_interval, "must be > 0");
+    require(c.densify_grad_threshold >= 0.0, "densify_grad_threshold", c.densify_grad_threshold,
+            "must be >= 0");
+    require(c.min_opacity >= 0.0 && c.min_opacity < 1.0, "min_opacity", c.min_opacity, "must be in [0, 1)");
+    require(c.max_screen_size >= 0.0, "max_screen_size", c.max_screen_size, "must be >= 0");
+    require(c.percent_dense > 0.0, "percent_dense", c.percent_dense, "must be > 0");
+
+    // Bookkeeping.
+    require(c.checkpoint_interval >= 0, "checkpoint_interval", c.checkpoint_interval,
+            "must be >= 0 (0 = only at the end)");
+    require(c.log_interval > 0, "log_interval", c.log_interval, "must be > 0");
+}
+
+}  // namespace lumigauss
