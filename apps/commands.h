@@ -7,5 +7,6 @@ namespace lumigauss::cli {
 void register_info(CLI::App& app);
 void register_render(CLI::App& app);
 void register_synth(CLI::App& app);
+void register_train(CLI::App& app);
 
 }  // namespace lumigauss::cli

@@ -161,6 +161,20 @@ void GaussianModel::step(std::int64_t iteration) {
         if (has_grad_[int(p)]) adam_[int(p)].step(params_[int(p)], grads_[int(p)]);
 }
 
+void GaussianModel::drop_grad(ModelParam p) {
+    std::fill(grads_[int(p)].begin(), grads_[int(p)].end(), 0.0f);
+    has_grad_[int(p)] = false;
+}
+
+void GaussianModel::restore_densification_stats(std::vector<float> accum, std::vector<float> count,
+                                                std::vector<float> radii) {
+    if (accum.size() != size() || count.size() != size() || radii.size() != size())
+        throw Error("restore_densification_stats: saved statistics do not match the model size");
+    grad_accum_ = std::move(accum);
+    grad_count_ = std::move(count);
+    max_radii_ = std::move(radii);
+}
+
 void GaussianModel::reset_stats() {
     grad_accum_.assign(size(), 0.0f);
     grad_count_.assign(size(), 0.0f);

@@ -98,6 +98,9 @@ class GaussianModel {
     void accumulate_grads_from_activated(const SurfelGrads<float>& g);
 
     void zero_grad();
+    // Forgets this iteration's gradient of one group, so step() skips it (what torch does after a
+    // parameter tensor is replaced, e.g. by the opacity reset).
+    void drop_grad(ModelParam p);
     // One Adam step on every group that received a gradient; the xyz learning rate first follows the
     // exponential schedule at `iteration` (update_learning_rate).
     void step(std::int64_t iteration);
@@ -111,6 +114,9 @@ class GaussianModel {
     const std::vector<float>& grad_accum() const { return grad_accum_; }
     const std::vector<float>& grad_count() const { return grad_count_; }
     const std::vector<float>& max_radii() const { return max_radii_; }
+    // Puts back saved statistics (checkpoints); each must hold size() values.
+    void restore_densification_stats(std::vector<float> accum, std::vector<float> count,
+                                     std::vector<float> radii);
 
     // densify_and_clone, densify_and_split, then prune (2DGS densify_and_prune). max_screen_size <= 0
     // disables the screen/world-size rules (the official passes None before iteration 3000).

@@ -121,4 +121,13 @@ double ExponLrSchedule::operator()(std::int64_t step) const {
     return delay_rate * std::exp(std::log(lr_init) * (1.0 - t) + std::log(lr_final) * t);
 }
 
+void AdamGroup::restore(std::int64_t step, std::vector<float> exp_avg, std::vector<float> exp_avg_sq) {
+    if (exp_avg.size() != m_.size() || exp_avg_sq.size() != v_.size())
+        throw Error("Adam group '" + name_ + "': saved moments have " + std::to_string(exp_avg.size()) +
+                    " values, the parameters " + std::to_string(m_.size()));
+    step_ = step;
+    m_ = std::move(exp_avg);
+    v_ = std::move(exp_avg_sq);
+}
+
 }  // namespace lumigauss

@@ -37,6 +37,8 @@ class AdamGroup {
     void duplicate_rows(std::span<const std::size_t> rows);
     void reset_rows(std::span<const std::size_t> rows);
     void reset_moments();
+    // Puts back a saved state (checkpoints): step count and both moments, each of size() floats.
+    void restore(std::int64_t step, std::vector<float> exp_avg, std::vector<float> exp_avg_sq);
 
     const std::string& name() const { return name_; }
     double lr() const { return lr_; }

@@ -80,14 +80,12 @@ std::vector<T> blur(const std::vector<T>& in, int width, int height, int k) {
     for_each_row(height, [&](int y) {
         const T* src = in.data() + y * row;
         T* dst = tmp.data() + y * row;
-        for (int x = 0; x < width; ++x) {
-            T* o = dst + std::size_t(x) * k;
-            for (int t = 0; t < kWindow; ++t) {
-                const int xx = x + t - kRadius;
-                if (xx < 0 || xx >= width) continue;
-                const T* s = src + std::size_t(xx) * k;
-                for (int c = 0; c < k; ++c) o[c] += g[t] * s[c];
-            }
+        // One contiguous axpy per tap over the pixels where it lands inside the row (vectorises).
+        for (int t = 0; t < kWindow; ++t) {
+            const int x0 = std::max(0, kRadius - t), x1 = std::min(width, width + kRadius - t);
+            if (x1 <= x0) continue;
+            const T* s = src + std::ptrdiff_t(t - kRadius) * k;
+            for (std::size_t i = std::size_t(x0) * k; i < std::size_t(x1) * k; ++i) dst[i] += g[t] * s[i];
         }
     });
     for_each_row(height, [&](int y) {

@@ -1,0 +1,290 @@
+// `lumigauss train <scene> -o <run>`: trains a relightable surfel model with the three-stage LumiGauss
+// schedule, with a progress line, a JSON-lines log of every loss term, atomic checkpoints (at intervals, on
+// Ctrl-C and before stopping on a non-finite value) and exact --resume.
+#include <sys/resource.h>
+#include <tbb/global_control.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "commands.h"
+#include "lumigauss/io/atomic_file.h"
+#include "lumigauss/io/dataset.h"
+#include "lumigauss/io/image.h"
+#include "lumigauss/shading/surfel_shading.h"
+#include "lumigauss/train/checkpoint.h"
+#include "lumigauss/train/run_folder.h"
+#include "lumigauss/train/trainer.h"
+#include "lumigauss/util/error.h"
+
+namespace lumigauss::cli {
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_interrupt(int) {
+    g_interrupted = true;
+}
+
+struct TrainFlags {
+    std::string scene, out, preset = "paper", config_file;
+    std::vector<std::string> overrides;
+    std::int64_t iterations = 0, stop_after = 0;
+    int downscale = 0, threads = 0;
+    bool resume = false, force = false, quiet = false;
+};
+
+double peak_memory_mib() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_maxrss) / 1024.0;  // Linux: kilobytes
+}
+
+std::string read_text(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) fail_in_file(path, "cannot open");
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+TrainConfig config_from_flags(const TrainFlags& f) {
+    TrainConfig c = train_preset(f.preset);
+    if (!f.config_file.empty()) apply_train_config_json(c, read_text(f.config_file), f.config_file);
+    for (const auto& o : f.overrides) apply_train_config_override(c, o);
+    if (f.iterations > 0) c.iterations = f.iterations;
+    if (f.downscale > 0) c.downscale = f.downscale;
+    validate_train_config(c);
+    return c;
+}
+
+// Keeps the log lines up to `iteration` (a resumed run rewrites what followed its checkpoint).
+void truncate_log(const std::string& path, std::int64_t iteration) {
+    std::ifstream in(path);
+    if (!in) return;
+    std::string kept, line;
+    const std::string key = "\"iteration\":";
+    while (std::getline(in, line)) {
+        const auto pos = line.find(key);
+        if (pos == std::string::npos) continue;
+        if (std::stoll(line.substr(pos + key.size())) <= iteration) kept += line + "\n";
+    }
+    write_file_atomically(path, kept);
+}
+
+class Progress {
+  public:
+    Progress(std::int64_t total, bool quiet)
+        : total_(total), quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0) {}
+
+    void update(const StepReport& r, bool force) {
+        psnr_.push_back(r.psnr > 0 ? r.psnr : psnr_.empty() ? 0 : psnr_.back());
+        if (psnr_.size() > 50) psnr_.pop_front();
+        const auto now = std::chrono::steady_clock::now();
+        const double since = std::chrono::duration<double>(now - last_print_).count();
+        const bool due = tty_ ? since > 0.25 : r.iteration % std::max<std::int64_t>(1, total_ / 20) == 0;
+        if (quiet_ || (!due && !force)) return;
+        const double rate = double(r.iteration - last_iteration_) / std::max(since, 1e-9);
+        last_print_ = now;
+        last_iteration_ = r.iteration;
+        const double eta = rate > 0 ? double(total_ - r.iteration) / rate : 0;
+        std::fprintf(
+            stderr, "%s[%d %-10s] %6lld/%lld %3d%%  loss %.4f  psnr %5.2f  surfels %zu  %5.1f it/s  eta %s%s",
+            tty_ ? "\r" : "", int(r.stage), stage_name(r.stage), (long long)r.iteration, (long long)total_,
+            int(100 * r.iteration / std::max<std::int64_t>(total_, 1)), r.total, mean_psnr(), r.surfels, rate,
+            duration(eta).c_str(), tty_ ? "\033[K" : "\n");
+        std::fflush(stderr);
+    }
+    void finish() {
+        if (tty_ && !quiet_) std::fprintf(stderr, "\n");
+    }
+    double mean_psnr() const {
+        double s = 0;
+        for (double p : psnr_) s += p;
+        return psnr_.empty() ? 0 : s / double(psnr_.size());
+    }
+    static std::string duration(double seconds) {
+        char buf[32];
+        const auto t = (long long)seconds;
+        std::snprintf(buf, sizeof buf, "%lld:%02lld:%02lld", t / 3600, t / 60 % 60, t % 60);
+        return buf;
+    }
+
+  private:
+    std::int64_t total_;
+    bool quiet_, tty_;
+    std::chrono::steady_clock::time_point last_print_ = std::chrono::steady_clock::now();
+    std::int64_t last_iteration_ = 0;
+    std::deque<double> psnr_;
+};
+
+// previews/NAME.png for the first few training photos: the photo, the shadowed and the unshadowed render
+// under the photo's learned environment, side by side (values clipped to [0, 1]).
+void write_previews(const std::string& dir, const Trainer& trainer, int count) {
+    const auto& views = trainer.views();
+    std::filesystem::create_directories(dir);
+    for (int v = 0; v < std::min<int>(count, int(views.size())); ++v) {
+        const TrainView& view = views[std::size_t(v)];
+        const RasterImages<float> img = render_with_environment(
+            trainer.state().model, view.camera, trainer.state().lighting.env_sh(v), ShadingMode::Both);
+        const int w = view.rgb.width, h = view.rgb.height;
+        Image out(3 * w, h, 3);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                for (int c = 0; c < 3; ++c) {
+                    const std::size_t p = std::size_t(y) * std::size_t(w) + std::size_t(x);
+                    out.at(x, y, c) = view.rgb.at(x, y, c);
+                    out.at(w + x, y, c) =
+                        std::clamp(img.color[6 * p + std::size_t(kShadowedOffset + c)], 0.0f, 1.0f);
+                    out.at(2 * w + x, y, c) =
+                        std::clamp(img.color[6 * p + std::size_t(kUnshadowedOffset + c)], 0.0f, 1.0f);
+                }
+        std::filesystem::path name = std::filesystem::path(dir) / view.name;
+        name.replace_extension(".png");
+        std::filesystem::create_directories(name.parent_path());
+        write_png(name.string(), out);
+    }
+}
+
+void checkpoint(const RunPaths& paths, const TrainState& state) {
+    save_checkpoint(paths.checkpoint, state);
+}
+
+int run_train(const TrainFlags& f) {
+    std::unique_ptr<tbb::global_control> threads;
+    if (f.threads > 0)
+        threads =
+            std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, f.threads);
+    const RunPaths paths = run_paths(f.out);
+    std::unique_ptr<Trainer> trainer;
+    if (f.resume) {
+        if (!std::filesystem::exists(paths.checkpoint))
+            fail_in_file(paths.checkpoint, "no checkpoint to resume from (start the run without --resume)");
+        if (!f.config_file.empty() || !f.overrides.empty() || f.downscale > 0)
+            throw Error("--resume continues with the saved config; only --iterations may change");
+        TrainState state = load_checkpoint(paths.checkpoint);
+        if (f.iterations > 0) state.config.iterations = f.iterations;
+        DatasetOptions dopt;
+        dopt.downscale = state.config.downscale;
+        const Dataset data = load_dataset(f.scene, dopt);
+        trainer = std::make_unique<Trainer>(load_train_views(data), std::move(state));
+        truncate_log(paths.log, trainer->iteration());
+        std::printf("train: resuming %s at iteration %lld of %lld\n", f.out.c_str(),
+                    (long long)trainer->iteration(), (long long)trainer->state().config.iterations);
+    } else {
+        const TrainConfig config = config_from_flags(f);
+        if (std::filesystem::exists(paths.checkpoint) && !f.force)
+            fail_in_file(paths.checkpoint,
+                         "a run already exists here; continue it with --resume or replace it with --force");
+        std::filesystem::create_directories(f.out);
+        DatasetOptions dopt;
+        dopt.downscale = config.downscale;
+        const Dataset data = load_dataset(f.scene, dopt);
+        trainer = std::make_unique<Trainer>(load_train_views(data), data.point_xyz, data.point_rgb, config);
+        write_file_atomically(paths.config, train_config_to_json(config));
+        write_file_atomically(paths.log, "");
+        std::printf("train: %zu photos, %zu SfM points, preset %s, %lld iterations -> %s\n",
+                    trainer->views().size(), data.point_xyz.size(), config.preset.c_str(),
+                    (long long)config.iterations, f.out.c_str());
+        std::fflush(stdout);
+    }
+    const TrainConfig& config = trainer->state().config;
+    std::signal(SIGINT, on_interrupt);
+    std::signal(SIGTERM, on_interrupt);
+    std::ofstream log(paths.log, std::ios::app);
+    Progress progress(config.iterations, f.quiet);
+    const auto t0 = std::chrono::steady_clock::now();
+    auto elapsed = [&] {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    };
+    while (!trainer->done()) {
+        if (g_interrupted || (f.stop_after > 0 && trainer->iteration() >= f.stop_after)) {
+            progress.finish();
+            checkpoint(paths, trainer->state());
+            std::printf("train: stopped at iteration %lld; checkpoint %s (continue with --resume)\n",
+                        (long long)trainer->iteration(), paths.checkpoint.c_str());
+            return g_interrupted ? 130 : 0;
+        }
+        StepReport r;
+        try {
+            r = trainer->step();
+        } catch (const NonFiniteError& e) {
+            progress.finish();
+            checkpoint(paths, trainer->state());
+            std::fprintf(
+                stderr,
+                "error: %s. Stopped; the last good state (iteration %lld) is in %s. Lower the learning "
+                "rates or check the input photos, then continue with --resume.\n",
+                e.what(), (long long)trainer->iteration(), paths.checkpoint.c_str());
+            return 3;
+        }
+        const bool log_now = r.iteration % config.log_interval == 0 || r.densify_ran || trainer->done();
+        if (log_now) log << step_log_line(r, elapsed()) << '\n' << std::flush;
+        progress.update(r, trainer->done());
+        if (config.checkpoint_interval > 0 && r.iteration % config.checkpoint_interval == 0 &&
+            !trainer->done())
+            checkpoint(paths, trainer->state());
+    }
+    progress.finish();
+    checkpoint(paths, trainer->state());
+    save_run_model(paths, trainer->state());
+    write_previews((std::filesystem::path(f.out) / "previews").string(), *trainer, 4);
+    const auto& t = trainer->phase_times();
+    std::printf(
+        "train: done, %lld iterations in %s, %zu surfels, training PSNR %.2f dB (last 50), peak memory %.0f "
+        "MiB\n",
+        (long long)config.iterations, Progress::duration(elapsed()).c_str(), trainer->state().model.size(),
+        progress.mean_psnr(), peak_memory_mib());
+    std::printf(
+        "train: time in shading %.1fs, raster fwd %.1fs, losses %.1fs, raster bwd %.1fs, shading bwd %.1fs, "
+        "physical %.1fs, optimizer %.1fs, densify %.1fs\n",
+        t.shading, t.raster_forward, t.losses, t.raster_backward, t.shading_backward, t.physical, t.optimizer,
+        t.densify);
+    std::printf("train: model %s, lighting %s, photos %s\n", paths.model.c_str(), paths.lighting.c_str(),
+                paths.appearance.c_str());
+    return 0;
+}
+
+}  // namespace
+
+void register_train(CLI::App& app) {
+    auto f = std::make_shared<TrainFlags>();
+    CLI::App* cmd = app.add_subcommand(
+        "train",
+        "Train a relightable surfel model (LumiGauss, three stages) from photos under many lightings");
+    cmd->add_option("scene", f->scene, "Dataset folder (COLMAP layout with sparse/0 and images/)")
+        ->required();
+    cmd->add_option("-o,--output", f->out, "Run folder (model, lighting, config, log, checkpoint)")
+        ->required();
+    cmd->add_option("--preset", f->preset,
+                    "paper (official schedule, 40k iterations) or fast (3k, small scenes)")
+        ->check(CLI::IsMember({"paper", "fast"}))
+        ->capture_default_str();
+    cmd->add_option("--iterations", f->iterations, "Total iterations (overrides the preset)")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("-r,--resolution", f->downscale, "Downscale the photos by 1, 2, 4 or 8")
+        ->check(CLI::IsMember({1, 2, 4, 8}));
+    cmd->add_option("--config", f->config_file, "JSON file with config keys (see the run's config.json)");
+    cmd->add_option("--set", f->overrides, "Override one config key: --set lambda_shadow=5 (repeatable)");
+    cmd->add_flag("--resume", f->resume, "Continue the run in the output folder from its checkpoint");
+    cmd->add_flag("--force", f->force, "Replace an existing run in the output folder");
+    cmd->add_option("--stop-after", f->stop_after, "Checkpoint and stop after this iteration (resume later)")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--threads", f->threads, "Worker threads (default: all cores)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_flag("-q,--quiet", f->quiet, "No progress line");
+    cmd->callback([f] {
+        const int rc = run_train(*f);
+        if (rc != 0) throw CLI::RuntimeError(rc);
+    });
+}
+
+}  // namespace lumigauss::cli

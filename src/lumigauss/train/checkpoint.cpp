@@ -1,0 +1,190 @@
+#include "lumigauss/train/checkpoint.h"
+
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <span>
+
+#include "lumigauss/io/atomic_file.h"
+#include "lumigauss/util/error.h"
+
+namespace lumigauss {
+namespace {
+
+constexpr char kMagic[9] = "LGCKPT01";
+constexpr char kEndMarker[9] = "LGCKEND1";
+// Sanity bound on any length field, so a corrupt length fails clearly instead of allocating terabytes.
+constexpr std::uint64_t kMaxElements = std::uint64_t(1) << 36;
+
+class Writer {
+  public:
+    explicit Writer(std::ofstream& out) : out_(out) {}
+    void raw(const void* data, std::size_t bytes) {
+        out_.write(static_cast<const char*>(data), std::streamsize(bytes));
+    }
+    template <typename T>
+    void value(T v) {
+        raw(&v, sizeof(T));
+    }
+    void string(const std::string& s) {
+        value<std::uint64_t>(s.size());
+        raw(s.data(), s.size());
+    }
+    void floats(std::span<const float> v) {
+        value<std::uint64_t>(v.size());
+        raw(v.data(), v.size() * sizeof(float));
+    }
+    void adam(const AdamGroup& g) {
+        value<std::int64_t>(g.step_count());
+        floats(g.exp_avg());
+        floats(g.exp_avg_sq());
+    }
+
+  private:
+    std::ofstream& out_;
+};
+
+class Reader {
+  public:
+    Reader(std::ifstream& in, const std::string& path) : in_(in), path_(path) {}
+    void raw(void* data, std::size_t bytes, const char* what) {
+        in_.read(static_cast<char*>(data), std::streamsize(bytes));
+        if (!in_) fail_in_file(path_, std::string("truncated checkpoint (while reading ") + what + ")");
+    }
+    template <typename T>
+    T value(const char* what) {
+        T v;
+        raw(&v, sizeof(T), what);
+        return v;
+    }
+    std::uint64_t length(const char* what) {
+        const auto n = value<std::uint64_t>(what);
+        if (n > kMaxElements)
+            fail_in_file(path_, std::string("corrupt checkpoint (impossible length of ") + what + ")");
+        return n;
+    }
+    std::string string(const char* what) {
+        std::string s(length(what), '\0');
+        raw(s.data(), s.size(), what);
+        return s;
+    }
+    std::vector<float> floats(const char* what) {
+        std::vector<float> v(length(what));
+        raw(v.data(), v.size() * sizeof(float), what);
+        return v;
+    }
+    void adam(AdamGroup& g, const char* what) {
+        const auto step = value<std::int64_t>(what);
+        auto m = floats(what);
+        auto v = floats(what);
+        if (m.size() != g.size() || v.size() != g.size())
+            fail_in_file(path_, std::string("corrupt checkpoint (optimizer state of ") + what +
+                                    " has the wrong size)");
+        g.restore(step, std::move(m), std::move(v));
+    }
+
+  private:
+    std::ifstream& in_;
+    const std::string& path_;
+};
+
+}  // namespace
+
+void save_checkpoint(const std::string& path, const TrainState& s) {
+    write_atomically(path, [&](const std::string& tmp) {
+        std::ofstream out(tmp, std::ios::binary);
+        if (!out) fail_in_file(tmp, "cannot open for writing");
+        Writer w(out);
+        w.raw(kMagic, 8);
+        w.string(train_config_to_json(s.config));
+        w.value<std::int64_t>(s.iteration);
+        w.value<double>(s.scene_extent);
+        w.value<std::uint64_t>(s.image_names.size());
+        for (const auto& name : s.image_names) w.string(name);
+
+        w.value<std::uint64_t>(s.model.size());
+        for (int p = 0; p < kModelParamCount; ++p) {
+            w.floats(s.model.param(ModelParam(p)));
+            w.adam(s.model.adam(ModelParam(p)));
+        }
+        w.floats(s.model.grad_accum());
+        w.floats(s.model.grad_count());
+        w.floats(s.model.max_radii());
+
+        w.value<std::int32_t>(s.lighting.num_images());
+        for (int g = 0; g < kMlpGroupCount; ++g) {
+            w.floats(s.lighting.param(MlpGroup(g)));
+            w.adam(s.lighting_adam[std::size_t(g)]);
+        }
+        w.raw(kEndMarker, 8);
+        out.flush();
+        if (!out) fail_in_file(tmp, "write failed (disk full?)");
+    });
+}
+
+TrainState load_checkpoint(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) fail_in_file(path, "cannot open the checkpoint");
+    Reader r(in, path);
+    char magic[8];
+    r.raw(magic, 8, "magic");
+    if (std::memcmp(magic, kMagic, 8) != 0) fail_in_file(path, "not a LumiGauss checkpoint (wrong magic)");
+
+    TrainState s;
+    s.config = TrainConfig{};
+    apply_train_config_json(s.config, r.string("config"), path + " (embedded config)");
+    s.iteration = r.value<std::int64_t>("iteration");
+    s.scene_extent = r.value<double>("scene extent");
+    const auto names = r.length("photo count");
+    for (std::uint64_t i = 0; i < names; ++i) s.image_names.push_back(r.string("photo name"));
+
+    const auto surfels = r.length("surfel count");
+    std::vector<std::vector<float>> raw(kModelParamCount);
+    struct SavedAdam {
+        std::int64_t step;
+        std::vector<float> m, v;
+    };
+    std::vector<SavedAdam> adam(kModelParamCount);
+    for (int p = 0; p < kModelParamCount; ++p) {
+        raw[std::size_t(p)] = r.floats("surfel parameters");
+        if (raw[std::size_t(p)].size() != surfels * std::size_t(GaussianModel::width(ModelParam(p))))
+            fail_in_file(path, std::string("corrupt checkpoint (") + GaussianModel::name(ModelParam(p)) +
+                                   " has the wrong size)");
+        adam[std::size_t(p)].step = r.value<std::int64_t>("surfel optimizer");
+        adam[std::size_t(p)].m = r.floats("surfel optimizer");
+        adam[std::size_t(p)].v = r.floats("surfel optimizer");
+    }
+    s.model = GaussianModel::from_raw(std::move(raw), s.scene_extent, model_learning_rates(s.config));
+    for (int p = 0; p < kModelParamCount; ++p) {
+        auto& a = adam[std::size_t(p)];
+        if (a.m.size() != s.model.adam(ModelParam(p)).size() || a.v.size() != a.m.size())
+            fail_in_file(path, "corrupt checkpoint (surfel optimizer state has the wrong size)");
+        s.model.adam(ModelParam(p)).restore(a.step, std::move(a.m), std::move(a.v));
+    }
+    auto accum = r.floats("densification statistics");
+    auto count = r.floats("densification statistics");
+    auto radii = r.floats("densification statistics");
+    if (accum.size() != surfels || count.size() != surfels || radii.size() != surfels)
+        fail_in_file(path, "corrupt checkpoint (densification statistics have the wrong size)");
+    s.model.restore_densification_stats(std::move(accum), std::move(count), std::move(radii));
+
+    const auto images = r.value<std::int32_t>("lighting model");
+    if (images <= 0 || std::uint64_t(images) != names)
+        fail_in_file(path, "corrupt checkpoint (lighting model and photo list disagree)");
+    s.lighting = LightingMlp(images, 0);
+    s.lighting_adam = lighting_optimizer(s.config, images);
+    for (int g = 0; g < kMlpGroupCount; ++g) {
+        auto values = r.floats("lighting model");
+        if (values.size() != s.lighting.param(MlpGroup(g)).size())
+            fail_in_file(path, std::string("corrupt checkpoint (lighting ") + mlp_group_name(MlpGroup(g)) +
+                                   " has the wrong size)");
+        s.lighting.param(MlpGroup(g)) = std::move(values);
+        r.adam(s.lighting_adam[std::size_t(g)], mlp_group_name(MlpGroup(g)));
+    }
+    char end[8];
+    r.raw(end, 8, "end marker");
+    if (std::memcmp(end, kEndMarker, 8) != 0) fail_in_file(path, "corrupt checkpoint (no end marker)");
+    return s;
+}
+
+}  // namespace lumigauss

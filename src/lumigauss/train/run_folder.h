@@ -1,0 +1,31 @@
+#pragma once
+// The files of a training run folder:
+//   config.json       the full TrainConfig (train_config.h), written when the run starts
+//   log.jsonl         one JSON object per logged iteration with every loss term (append-only)
+//   checkpoint.lgck   the latest checkpoint (checkpoint.h), replaced atomically
+//   model.ply         the surfels, official LumiGauss relightable PLY layout (relightable_ply.h)
+//   lighting.lgmlp    the lighting MLP and embedding table (lighting_mlp.h)
+//   appearance.json   the photo names in embedding-table order: {"images": [{"name": ..., "index": i}]}
+// Every file is written atomically (temp + rename).
+#include <string>
+#include <vector>
+
+#include "lumigauss/train/trainer.h"
+
+namespace lumigauss {
+
+struct RunPaths {
+    std::string dir, config, log, checkpoint, model, lighting, appearance;
+};
+RunPaths run_paths(const std::string& dir);
+
+// model.ply, lighting.lgmlp and appearance.json of the state.
+void save_run_model(const RunPaths& paths, const TrainState& state);
+
+// The photo names of appearance.json, in embedding order. Throws Error naming the file if malformed.
+std::vector<std::string> load_appearance(const std::string& path);
+
+// One log line (JSON object, no newline) for a step.
+std::string step_log_line(const StepReport& report, double elapsed_seconds);
+
+}  // namespace lumigauss

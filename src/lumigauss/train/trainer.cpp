@@ -1,0 +1,390 @@
+#include "lumigauss/train/trainer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+#include "lumigauss/io/scene_extent.h"
+#include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/synth/rng.h"
+#include "lumigauss/train/depth_normal.h"
+#include "lumigauss/train/image_losses.h"
+#include "lumigauss/train/physical_losses.h"
+#include "lumigauss/util/error.h"
+
+namespace lumigauss {
+namespace {
+
+// Stream purposes of the training generator.
+constexpr std::uint64_t kCameraOrder = 0x63616d6f72646572ULL;  // "camorder"
+constexpr std::uint64_t kEnvNoise = 0x656e766e6f697365ULL;     // "envnoise"
+constexpr std::uint64_t kDensify = 0x64656e736966ULL;          // "densif"
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+}  // namespace
+
+ModelLearningRates model_learning_rates(const TrainConfig& c) {
+    ModelLearningRates lr;
+    lr.position_init = c.lr_position_init;
+    lr.position_final = c.lr_position_final;
+    lr.position_max_steps = c.lr_position_max_steps;
+    lr.transfer = c.lr_transfer;
+    lr.opacity = c.lr_opacity;
+    lr.scaling = c.lr_scaling;
+    lr.rotation = c.lr_rotation;
+    lr.albedo = c.lr_albedo;
+    return lr;
+}
+
+std::vector<AdamGroup> lighting_optimizer(const TrainConfig& c, int num_images) {
+    std::vector<AdamGroup> groups;
+    for (int g = 0; g < kMlpGroupCount; ++g) {
+        const auto group = MlpGroup(g);
+        const double lr = group == MlpGroup::kEmbedding ? c.lr_embedding : c.lr_mlp;
+        groups.emplace_back(mlp_group_name(group), LightingMlp::group_size(group, num_images), lr,
+                            LightingMlp::row_width(group));
+    }
+    return groups;
+}
+
+namespace {
+
+// Deinterleaves channels [first, first + 3) of an image with `channels` values per pixel.
+void extract_rgb(const std::vector<float>& src, int channels, int first, std::vector<float>& dst) {
+    const std::size_t pixels = src.size() / std::size_t(channels);
+    dst.resize(3 * pixels);
+    for (std::size_t p = 0; p < pixels; ++p)
+        for (int c = 0; c < 3; ++c)
+            dst[3 * p + std::size_t(c)] = src[p * std::size_t(channels) + std::size_t(first + c)];
+}
+
+void insert_rgb(const std::vector<float>& src, int channels, int first, std::vector<float>& dst) {
+    const std::size_t pixels = src.size() / 3;
+    for (std::size_t p = 0; p < pixels; ++p)
+        for (int c = 0; c < 3; ++c)
+            dst[p * std::size_t(channels) + std::size_t(first + c)] = src[3 * p + std::size_t(c)];
+}
+
+double masked_psnr(std::span<const float> rendered, std::span<const float> target,
+                   std::span<const float> mask) {
+    double err = 0, weight = 0;
+    for (std::size_t p = 0; p < mask.size(); ++p) {
+        for (int c = 0; c < 3; ++c) {
+            const double d =
+                double(rendered[3 * p + std::size_t(c)]) - double(target[3 * p + std::size_t(c)]);
+            err += double(mask[p]) * d * d;
+        }
+        weight += 3.0 * double(mask[p]);
+    }
+    const double mse = weight > 0 ? err / weight : 0.0;
+    return -10.0 * std::log10(mse + 1e-10);
+}
+
+bool all_finite(std::span<const float> v) {
+    for (float x : v)
+        if (!std::isfinite(x)) return false;
+    return true;
+}
+
+}  // namespace
+
+std::vector<TrainView> load_train_views(const Dataset& dataset) {
+    std::vector<TrainView> out;
+    for (const View* v : dataset.split(Split::Train)) {
+        TrainView t;
+        t.name = v->name;
+        t.camera = v->camera;
+        t.rgb = dataset.load_image(*v);
+        t.mask = dataset.load_mask(*v);
+        out.push_back(std::move(t));
+    }
+    return out;
+}
+
+Stage stage_of(const TrainConfig& config, std::int64_t iteration) {
+    if (iteration < config.warmup) return Stage::Unshadowed;
+    if (iteration <= config.start_shadowed) return Stage::TransferFitting;
+    return Stage::Shadowed;
+}
+
+const char* stage_name(Stage stage) {
+    switch (stage) {
+        case Stage::Unshadowed:
+            return "unshadowed";
+        case Stage::TransferFitting:
+            return "transfer";
+        case Stage::Shadowed:
+            return "shadowed";
+    }
+    return "?";
+}
+
+NonFiniteError::NonFiniteError(std::int64_t iteration_, std::string term_)
+    : std::runtime_error("iteration " + std::to_string(iteration_) + ": " + term_ +
+                         " is not finite (NaN or Inf)"),
+      iteration(iteration_),
+      term(std::move(term_)) {}
+
+struct Trainer::Scratch {
+    ViewNormals normals;
+    SurfelBatch<float> batch;
+    RasterState<float> raster;
+    RasterImages<float> images;
+    RasterImageGrads<float> image_grads;
+    std::vector<float> rendered, grad_rendered, radii, mean2d;
+    RasterSettings<float> settings;
+};
+
+Trainer::Trainer(std::vector<TrainView> views, const std::vector<Vec3f>& point_xyz,
+                 const std::vector<Vec3f>& point_rgb, const TrainConfig& config)
+    : views_(std::move(views)), scratch_(std::make_unique<Scratch>()) {
+    validate_train_config(config);
+    if (views_.empty()) throw Error("training needs at least one training photo; the dataset has none");
+    if (point_xyz.empty())
+        throw Error("training starts from SfM points, and the dataset has none (sparse/0/points3D)");
+    state_.config = config;
+    std::vector<View> cams(views_.size());
+    for (std::size_t i = 0; i < views_.size(); ++i) cams[i].camera = views_[i].camera;
+    state_.scene_extent = camera_extent(cams).radius;
+    for (const auto& v : views_) state_.image_names.push_back(v.name);
+    state_.model = GaussianModel::from_points(point_xyz, point_rgb, state_.scene_extent, config.seed,
+                                              model_learning_rates(config));
+    state_.lighting = LightingMlp(int(views_.size()), std::uint32_t(config.seed));
+    state_.lighting_adam = lighting_optimizer(config, int(views_.size()));
+}
+
+Trainer::Trainer(std::vector<TrainView> views, TrainState state)
+    : views_(std::move(views)), state_(std::move(state)), scratch_(std::make_unique<Scratch>()) {
+    validate_train_config(state_.config);
+    if (views_.size() != state_.image_names.size())
+        throw Error("the saved run was trained on " + std::to_string(state_.image_names.size()) +
+                    " photos, the dataset has " + std::to_string(views_.size()) + " training photos");
+    for (std::size_t i = 0; i < views_.size(); ++i)
+        if (views_[i].name != state_.image_names[i])
+            throw Error("the saved run's training photo " + std::to_string(i) + " is '" +
+                        state_.image_names[i] + "', the dataset's is '" + views_[i].name + "'");
+}
+
+Trainer::~Trainer() = default;
+
+int Trainer::view_for_iteration(std::int64_t iteration) const {
+    // Official: pop a random camera from a list refilled each epoch, i.e. a permutation per epoch.
+    const auto n = std::int64_t(views_.size());
+    const std::int64_t k = iteration - 1, epoch = k / n, pos = k % n;
+    std::vector<int> order(static_cast<std::size_t>(n));
+    std::iota(order.begin(), order.end(), 0);
+    synth::Rng rng(synth::hash_keys(state_.config.seed, kCameraOrder, std::uint64_t(epoch)));
+    for (std::int64_t i = n - 1; i > 0; --i)
+        std::swap(order[std::size_t(i)], order[std::size_t(rng.uniform_int(0, int(i)))]);
+    return order[std::size_t(pos)];
+}
+
+void Trainer::set_learning_rates(std::int64_t iteration) {
+    const TrainConfig& c = state_.config;
+    // Official update_lambdas: during (warmup, start_shadowed] the lighting and rotation rates are 0; after
+    // it the rotation rate is restored and the lighting rates divided by lr_env_final_ratio.
+    const bool frozen = iteration > c.warmup && iteration <= c.start_shadowed;
+    const bool late = iteration > c.start_shadowed;
+    state_.model.adam(ModelParam::Rotation).set_lr(frozen ? 0.0 : c.lr_rotation);
+    for (int g = 0; g < kMlpGroupCount; ++g) {
+        const double base = MlpGroup(g) == MlpGroup::kEmbedding ? c.lr_embedding : c.lr_mlp;
+        state_.lighting_adam[std::size_t(g)].set_lr(frozen ? 0.0 : late ? base / c.lr_env_final_ratio : base);
+    }
+}
+
+StepReport Trainer::step() {
+    const std::int64_t it = state_.iteration + 1;
+    const Stage stage = stage_of(state_.config, it);
+    StepReport report;
+    report.iteration = it;
+    report.stage = stage;
+    state_.model.zero_grad();
+    state_.lighting.zero_grad();
+    lighting_has_grad_ = false;
+    set_learning_rates(it);
+
+    report.view = view_for_iteration(it);
+    compute_view_normals(state_.model, views_[std::size_t(report.view)].camera, scratch_->normals);
+    if (stage != Stage::TransferFitting) render_step(it, stage, report);
+    physical_step(it, stage, report);
+    check_finite(it, report);
+    densify_step(it, stage, report);
+    optimizer_step(it, stage);
+    report.surfels = state_.model.size();
+    state_.iteration = it;
+    return report;
+}
+
+void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
+    const TrainConfig& c = state_.config;
+    Scratch& s = *scratch_;
+    const TrainView& view = views_[std::size_t(report.view)];
+    GaussianModel& model = state_.model;
+
+    auto t0 = Clock::now();
+    const LightingForward<float> env_pass = state_.lighting.forward(report.view);
+    // 3.5: one noise draw per iteration, shared by both renders; l_+ sees the clean SH.
+    ShCoeffs<float> env = env_pass.sh;
+    synth::Rng noise(synth::hash_keys(c.seed, kEnvNoise, std::uint64_t(it)));
+    for (int k = 0; k < kShCount; ++k)
+        for (int ch = 0; ch < 3; ++ch) env.c[k][ch] += float(noise.normal() * c.env_noise_sigma);
+    const ShadingMode mode = stage == Stage::Shadowed ? ShadingMode::Both : ShadingMode::Unshadowed;
+    model.activated(s.batch);
+    shade_surfels(model, env, mode, s.normals, s.batch);
+    times_.shading += seconds_since(t0);
+
+    t0 = Clock::now();
+    rasterize_forward_cpu(view.camera, s.batch, s.settings, s.raster, s.images);
+    times_.raster_forward += seconds_since(t0);
+
+    t0 = Clock::now();
+    const int channels = s.batch.channels;
+    const ImageShape shape{view.rgb.width, view.rgb.height, 3};
+    std::span<const float> target = view.rgb.pixels, mask = view.mask.pixels;
+    RasterImageGrads<float>& g = s.image_grads;
+    g = RasterImageGrads<float>{};
+    g.width = shape.width, g.height = shape.height, g.channels = channels;
+    g.color.assign(s.images.color.size(), 0.0f);
+    const auto photometric = [&](int first, double weight, double& l1, double& dssim) -> double {
+        extract_rgb(s.images.color, channels, first, s.rendered);
+        s.grad_rendered.assign(s.rendered.size(), 0.0f);
+        l1 = masked_l1_loss<float>(shape, s.rendered, target, mask, float(weight * (1 - c.lambda_dssim)),
+                                   s.grad_rendered);
+        dssim = masked_dssim_loss<float>(shape, s.rendered, target, mask, float(weight * c.lambda_dssim),
+                                         s.grad_rendered);
+        insert_rgb(s.grad_rendered, channels, first, g.color);
+        return masked_psnr(s.rendered, target, mask);
+    };
+    double image_total = 0;
+    if (stage == Stage::Unshadowed) {
+        report.psnr = photometric(0, 1.0, report.l1_unshadowed, report.dssim_unshadowed);
+        image_total = (1 - c.lambda_dssim) * report.l1_unshadowed + c.lambda_dssim * report.dssim_unshadowed;
+    } else {
+        photometric(kUnshadowedOffset, c.lambda_unshadowed_stage3, report.l1_unshadowed,
+                    report.dssim_unshadowed);
+        report.psnr = photometric(kShadowedOffset, 1.0, report.l1_shadowed, report.dssim_shadowed);
+        image_total = (1 - c.lambda_dssim) * report.l1_shadowed + c.lambda_dssim * report.dssim_shadowed +
+                      c.lambda_unshadowed_stage3 * ((1 - c.lambda_dssim) * report.l1_unshadowed +
+                                                    c.lambda_dssim * report.dssim_unshadowed);
+    }
+    report.total += image_total;
+    if (it > c.start_regularization) {
+        report.normal =
+            normal_consistency_loss<float>(view.camera, s.images, mask, float(c.lambda_normal), &g);
+        report.distortion = distortion_loss<float>(s.images, mask, float(c.lambda_distortion), &g);
+        report.total += c.lambda_normal * report.normal + c.lambda_distortion * report.distortion;
+    }
+    ShCoeffs<float> g_env{};
+    report.env = env_nonnegativity_loss(env_pass.sh, c.env_samples, c.seed, it, c.lambda_env, g_env);
+    report.total += c.lambda_env * report.env;
+    times_.losses += seconds_since(t0);
+
+    t0 = Clock::now();
+    const SurfelGrads<float> sg = rasterize_backward_cpu(s.batch, s.raster, g);
+    times_.raster_backward += seconds_since(t0);
+
+    t0 = Clock::now();
+    model.accumulate_grads_from_activated(sg);
+    const ShCoeffs<float> g_shading = shade_surfels_backward(model, env, mode, s.normals, sg.colors);
+    for (int k = 0; k < kShCount; ++k) g_env.c[k] = g_env.c[k] + g_shading.c[k];
+    state_.lighting.backward(env_pass, g_env);
+    lighting_has_grad_ = true;
+    // Densification statistics come from this render's screen-space gradient (2DGS: radii > 0 visible).
+    if (it < c.densify_until) {
+        const std::size_t n = model.size();
+        s.radii.assign(n, 0.0f);
+        for (std::size_t i = 0; i < n; ++i) {
+            const auto& r = s.raster.projected[i].rect;
+            if (s.raster.visible[i] && !r.empty())
+                s.radii[i] = 0.5f * float(std::max(r.x1 - r.x0 + 1, r.y1 - r.y0 + 1));
+        }
+        s.mean2d = sg.mean2d;
+    }
+    times_.shading_backward += seconds_since(t0);
+}
+
+void Trainer::physical_step(std::int64_t it, Stage stage, StepReport& report) {
+    if (stage == Stage::Unshadowed) return;  // stage 1: the transfer gets no gradient (5)
+    const TrainConfig& c = state_.config;
+    const auto t0 = Clock::now();
+    TransferLossWeights<double> w;
+    w.range01 = c.lambda_range01;
+    w.consistency = c.lambda_consistency;
+    w.shadow = stage == Stage::Shadowed ? c.lambda_shadow : 0.0;
+    const TransferLossResult r =
+        model_transfer_losses(state_.model, scratch_->normals, c.transfer_samples, c.seed, it, w, true);
+    report.range01 = r.losses.range01;
+    report.consistency = r.losses.consistency;
+    report.shadow = r.losses.shadow;
+    report.total += r.weighted;
+    times_.physical += seconds_since(t0);
+}
+
+void Trainer::check_finite(std::int64_t it, const StepReport& r) const {
+    const std::pair<const char*, double> terms[] = {{"loss l1 (shadowed)", r.l1_shadowed},
+                                                    {"loss D-SSIM (shadowed)", r.dssim_shadowed},
+                                                    {"loss l1 (unshadowed)", r.l1_unshadowed},
+                                                    {"loss D-SSIM (unshadowed)", r.dssim_unshadowed},
+                                                    {"loss l_[0,1]", r.range01},
+                                                    {"loss l_consistency", r.consistency},
+                                                    {"loss l_shadow", r.shadow},
+                                                    {"loss l_+ (environment)", r.env},
+                                                    {"loss normal consistency", r.normal},
+                                                    {"loss distortion", r.distortion}};
+    for (const auto& [name, value] : terms)
+        if (!std::isfinite(value)) throw NonFiniteError(it, name);
+    for (int p = 0; p < kModelParamCount; ++p)
+        if (state_.model.has_grad(ModelParam(p)) && !all_finite(state_.model.grad(ModelParam(p))))
+            throw NonFiniteError(it, std::string("gradient of ") + GaussianModel::name(ModelParam(p)));
+    for (int g = 0; g < kMlpGroupCount; ++g)
+        if (!all_finite(state_.lighting.grad(MlpGroup(g))))
+            throw NonFiniteError(it, std::string("gradient of lighting ") + mlp_group_name(MlpGroup(g)));
+}
+
+void Trainer::densify_step(std::int64_t it, Stage stage, StepReport& report) {
+    const TrainConfig& c = state_.config;
+    GaussianModel& model = state_.model;
+    // Official: only while it < densify_until and outside stage 2.
+    if (it >= c.densify_until || stage == Stage::TransferFitting) return;
+    const auto t0 = Clock::now();
+    const TrainView& view = views_[std::size_t(report.view)];
+    model.add_densification_stats(scratch_->mean2d, scratch_->raster.visible, scratch_->radii,
+                                  view.camera.width, view.camera.height);
+    if (it > c.densify_from && it % c.densify_interval == 0) {
+        const double max_screen = it > c.opacity_reset_interval ? c.max_screen_size : 0.0;
+        DensifyOptions opt;
+        opt.percent_dense = c.percent_dense;
+        opt.faithful_radii_reset = c.faithful_radii_reset;
+        report.densified =
+            model.densify_and_prune(c.densify_grad_threshold, c.min_opacity, state_.scene_extent, max_screen,
+                                    synth::hash_keys(c.seed, kDensify, std::uint64_t(it)), opt);
+        report.densify_ran = true;
+        // torch: the replaced parameter tensors have no gradient, so Adam skips them this iteration.
+        model.zero_grad();
+    }
+    if (it % c.opacity_reset_interval == 0) {
+        model.reset_opacity();
+        model.drop_grad(ModelParam::Opacity);
+        report.opacity_reset = true;
+    }
+    times_.densify += seconds_since(t0);
+}
+
+void Trainer::optimizer_step(std::int64_t it, Stage) {
+    if (it >= state_.config.iterations) return;  // official: no step on the last iteration
+    const auto t0 = Clock::now();
+    state_.model.step(it);
+    if (lighting_has_grad_)
+        for (int g = 0; g < kMlpGroupCount; ++g)
+            state_.lighting_adam[std::size_t(g)].step(state_.lighting.param(MlpGroup(g)),
+                                                      state_.lighting.grad(MlpGroup(g)));
+    times_.optimizer += seconds_since(t0);
+}
+
+}  // namespace lumigauss

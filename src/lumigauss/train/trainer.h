@@ -1,0 +1,125 @@
+#pragma once
+// One LumiGauss training run: the surfel model, the lighting model (per-photo embedding -> MLP -> SH), their
+// optimizers, and the iteration loop of the official train.py with its three stages
+// (research/lumigauss_official.md 3-5; the schedule is described in train_config.h).
+//
+// Everything random is drawn from counter-based streams keyed by (seed, purpose, iteration, ...): the
+// camera order (a fresh permutation per epoch), the SH noise, the Monte Carlo directions and the split
+// samples. A run is therefore a pure function of its config and its state at an iteration, which is what
+// makes `--resume` exact: a checkpoint holds the state, never a generator.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "lumigauss/io/dataset.h"
+#include "lumigauss/io/image.h"
+#include "lumigauss/render/raster_types.h"
+#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/train/adam.h"
+#include "lumigauss/train/lighting_mlp.h"
+#include "lumigauss/train/train_config.h"
+#include "lumigauss/train/view_shading.h"
+
+namespace lumigauss {
+
+// A training photo in memory: RGB in [0, 1], its mask (one value per pixel; all ones without a mask file).
+struct TrainView {
+    std::string name;
+    Camera camera;
+    Image rgb;
+    Image mask;
+};
+
+// The training photos of a dataset (its train split), in dataset (name) order; the position in this list
+// is the photo's row in the embedding table.
+std::vector<TrainView> load_train_views(const Dataset& dataset);
+
+enum class Stage { Unshadowed = 1, TransferFitting = 2, Shadowed = 3 };
+Stage stage_of(const TrainConfig& config, std::int64_t iteration);
+const char* stage_name(Stage stage);
+
+// Every term of one iteration, unweighted (0 when not computed), plus the weighted total.
+struct StepReport {
+    std::int64_t iteration = 0;
+    Stage stage = Stage::Unshadowed;
+    int view = -1;  // index into the training views (-1: none rendered)
+    double total = 0;
+    double l1_shadowed = 0, dssim_shadowed = 0;
+    double l1_unshadowed = 0, dssim_unshadowed = 0;
+    double range01 = 0, consistency = 0, shadow = 0;
+    double env = 0, normal = 0, distortion = 0;
+    double psnr = 0;  // masked PSNR of the stage's main render (shadowed in stage 3), 0 in stage 2
+    std::size_t surfels = 0;
+    DensifyReport densified{};
+    bool densify_ran = false, opacity_reset = false;
+};
+
+// The state that fully determines the rest of a run (what a checkpoint stores).
+struct TrainState {
+    TrainConfig config;
+    std::int64_t iteration = 0;  // iterations completed
+    double scene_extent = 1;     // cameras_extent (xyz learning rate and densification scale)
+    std::vector<std::string> image_names;
+    GaussianModel model;
+    LightingMlp lighting;
+    std::vector<AdamGroup> lighting_adam;  // one per MlpGroup
+};
+
+// The model's learning rates and the lighting model's optimizer (one Adam group per MlpGroup) of a config.
+ModelLearningRates model_learning_rates(const TrainConfig& config);
+std::vector<AdamGroup> lighting_optimizer(const TrainConfig& config, int num_images);
+
+class Trainer {
+  public:
+    // A new run: surfels from the dataset's SfM points, lighting model from the config's seed. Throws Error
+    // if the dataset has no SfM points or no training photos.
+    Trainer(std::vector<TrainView> views, const std::vector<Vec3f>& point_xyz,
+            const std::vector<Vec3f>& point_rgb, const TrainConfig& config);
+    // Continues a saved state. Throws Error if the photos differ from the ones the state was trained on.
+    Trainer(std::vector<TrainView> views, TrainState state);
+    ~Trainer();
+
+    // Runs iteration() + 1. Throws NonFiniteError (state untouched by that iteration's update) if a loss
+    // term or a gradient is not finite.
+    StepReport step();
+    bool done() const { return state_.iteration >= state_.config.iterations; }
+    std::int64_t iteration() const { return state_.iteration; }
+
+    const TrainState& state() const { return state_; }
+    TrainState& state() { return state_; }
+    const std::vector<TrainView>& views() const { return views_; }
+    // The training view used at a given iteration (a fresh permutation of the photos per epoch).
+    int view_for_iteration(std::int64_t iteration) const;
+
+    // Time spent in each phase since construction (seconds), for profiling and benchmarks.
+    struct PhaseTimes {
+        double shading = 0, raster_forward = 0, losses = 0, raster_backward = 0, shading_backward = 0,
+               physical = 0, optimizer = 0, densify = 0;
+    };
+    const PhaseTimes& phase_times() const { return times_; }
+
+  private:
+    struct Scratch;
+    void set_learning_rates(std::int64_t iteration);
+    void render_step(std::int64_t iteration, Stage stage, StepReport& report);
+    void physical_step(std::int64_t iteration, Stage stage, StepReport& report);
+    void densify_step(std::int64_t iteration, Stage stage, StepReport& report);
+    void check_finite(std::int64_t iteration, const StepReport& report) const;
+    void optimizer_step(std::int64_t iteration, Stage stage);
+
+    std::vector<TrainView> views_;
+    TrainState state_;
+    std::unique_ptr<Scratch> scratch_;
+    PhaseTimes times_;
+    bool lighting_has_grad_ = false;
+};
+
+// Thrown when a loss term or gradient is not finite; `term` names it.
+struct NonFiniteError : std::runtime_error {
+    NonFiniteError(std::int64_t iteration_, std::string term_);
+    std::int64_t iteration;
+    std::string term;
+};
+
+}  // namespace lumigauss
