@@ -1,0 +1,277 @@
+// `lumigauss train`: a short run on the tiny synthetic scene writes every run file, --stop-after then
+// --resume reproduces the straight run byte for byte, an existing run is protected unless --resume or
+// --force is given, and bad input fails with a message naming the file or key.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "lumigauss/io/dataset.h"
+#include "lumigauss/scene/relightable_ply.h"
+#include "lumigauss/train/checkpoint.h"
+#include "lumigauss/train/lighting_mlp.h"
+#include "lumigauss/train/run_folder.h"
+#include "synth_test_util.h"
+
+namespace lumigauss {
+namespace {
+
+using synth_test::TempDir;
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+struct CommandResult {
+    int exit_code = -1;
+    std::string output;
+};
+
+CommandResult run_lumigauss(const std::string& args, const TempDir& tmp) {
+    const std::string out = tmp.sub("output.txt");
+    const std::string command = std::string("'") + LUMIGAUSS_BINARY + "' " + args + " > '" + out + "' 2>&1";
+    const int status = std::system(command.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, synth_test::read_bytes(out)};
+}
+
+// The tiny scene, generated once per test process.
+const std::string& tiny_scene() {
+    static TempDir dir("cli_train_scene");
+    static const std::string root = [] {
+        synth::generate_synthetic_scene(synth_test::tiny_options(dir.str()));
+        return dir.str();
+    }();
+    return root;
+}
+
+std::string quoted(const std::string& s) {
+    return "'" + s + "'";
+}
+
+// A 60-iteration run through all three stages: stage 1 to 29, stage 2 30..35, stage 3 from 36;
+// densification at 20 and 40 (30 is in stage 2), an opacity reset at 40; a log line every 5 iterations.
+const std::string kSchedule =
+    " --preset fast --iterations 60 --set warmup=30 --set start_shadowed=35 --set densify_from=10"
+    " --set densify_until=50 --set densify_interval=10 --set opacity_reset_interval=40"
+    " --set start_regularization=20 --set lr_position_max_steps=50 --set log_interval=5"
+    " --set checkpoint_interval=20 -q";
+
+std::string train_args(const std::string& run, const std::string& extra = kSchedule) {
+    return "train " + quoted(tiny_scene()) + " -o " + quoted(run) + extra;
+}
+
+const std::vector<std::string> kRunFiles = {"config.json", "log.jsonl",      "checkpoint.lgck",
+                                            "model.ply",   "lighting.lgmlp", "appearance.json"};
+
+std::vector<nlohmann::json> read_log(const std::string& path) {
+    std::ifstream in(path);
+    std::vector<nlohmann::json> lines;
+    std::string line;
+    while (std::getline(in, line)) {
+        nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+        EXPECT_FALSE(j.is_discarded()) << "not JSON: " << line;
+        EXPECT_TRUE(j.is_object()) << line;
+        lines.push_back(std::move(j));
+    }
+    return lines;
+}
+
+std::vector<std::int64_t> log_iterations(const std::vector<nlohmann::json>& log) {
+    std::vector<std::int64_t> its;
+    for (const auto& j : log) its.push_back(j.value("iteration", std::int64_t(-1)));
+    return its;
+}
+
+// Every file under a folder (relative path) with its bytes.
+std::map<std::string, std::string> folder_bytes(const std::string& dir) {
+    std::map<std::string, std::string> files;
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+        if (e.is_regular_file())
+            files[fs::relative(e.path(), dir).string()] = synth_test::read_bytes(e.path().string());
+    return files;
+}
+
+// ---- 7. A run writes every file ----------------------------------------------------------------------
+
+TEST(CliTrain, ShortRunWritesEveryRunFile) {
+    TempDir tmp("cli_train_files");
+    const std::string run = tmp / "run";
+    const CommandResult r = run_lumigauss(train_args(run), tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    for (const std::string& f : kRunFiles) EXPECT_TRUE(fs::exists(run + "/" + f)) << f << "\n" << r.output;
+    EXPECT_THAT(r.output, HasSubstr("train: done"));
+
+    // config.json: the full config with the overrides.
+    const nlohmann::json config = synth_test::read_json(run + "/config.json");
+    ASSERT_TRUE(config.is_object());
+    EXPECT_EQ(config["preset"], "fast");
+    EXPECT_EQ(config["iterations"], 60);
+    EXPECT_EQ(config["warmup"], 30);
+    EXPECT_EQ(config["start_shadowed"], 35);
+    EXPECT_EQ(config["densify_from"], 10);
+    EXPECT_EQ(config["densify_until"], 50);
+    EXPECT_EQ(config["densify_interval"], 10);
+    EXPECT_EQ(config["opacity_reset_interval"], 40);
+    EXPECT_EQ(config["start_regularization"], 20);
+    EXPECT_EQ(config["lr_position_max_steps"], 50);
+    EXPECT_EQ(config["log_interval"], 5);
+    EXPECT_EQ(config["lambda_shadow"], 10.0);  // a preset value kept
+    TrainConfig parsed = train_preset("paper");
+    apply_train_config_json(parsed, synth_test::read_bytes(run + "/config.json"), "config.json");
+    EXPECT_EQ(parsed.warmup, 30);
+    EXPECT_EQ(parsed.preset, "fast");
+
+    // log.jsonl: one object per logged iteration, every loss key, in order.
+    const std::vector<nlohmann::json> log = read_log(run + "/log.jsonl");
+    ASSERT_FALSE(log.empty());
+    for (const auto& j : log)
+        for (const char* key : {"iteration", "stage", "total", "l1_shadowed", "dssim_shadowed",
+                                "l1_unshadowed", "dssim_unshadowed", "range01", "consistency", "shadow",
+                                "env", "normal", "distortion", "psnr", "surfels"})
+            EXPECT_TRUE(j.contains(key)) << key << " missing in " << j.dump();
+    const std::vector<std::int64_t> its = log_iterations(log);
+    std::vector<std::int64_t> expected;
+    for (std::int64_t i = 5; i <= 60; i += 5) expected.push_back(i);
+    EXPECT_EQ(its, expected);  // densification at 20 and 40 falls on logged iterations
+    std::set<int> stages;
+    for (const auto& j : log) {
+        const std::int64_t it = j["iteration"];
+        const int stage = j["stage"];
+        stages.insert(stage);
+        EXPECT_EQ(stage, it < 30 ? 1 : it <= 35 ? 2 : 3) << it;
+        EXPECT_EQ(j.contains("cloned"), it == 20 || it == 40) << it;
+    }
+    EXPECT_EQ(stages, (std::set<int>{1, 2, 3}));
+
+    // The model files load and agree with the log and the scene.
+    const Dataset scene = load_dataset(tiny_scene());
+    std::vector<std::string> train_names;
+    for (const View* v : scene.split(Split::Train)) train_names.push_back(v->name);
+    EXPECT_EQ(load_appearance(run + "/appearance.json"), train_names);
+    const GaussianModel model = load_relightable_ply(run + "/model.ply");
+    EXPECT_EQ(model.size(), log.back()["surfels"].get<std::size_t>());
+    EXPECT_GT(model.size(), 0u);
+    EXPECT_EQ(load_lighting_mlp(run + "/lighting.lgmlp").num_images(), int(train_names.size()));
+    const TrainState state = load_checkpoint(run + "/checkpoint.lgck");
+    EXPECT_EQ(state.iteration, 60);
+    EXPECT_EQ(state.model.size(), model.size());
+    EXPECT_EQ(state.image_names, train_names);
+}
+
+// ---- 8. --stop-after then --resume is the straight run ----------------------------------------------------
+
+TEST(CliTrain, StopAfterThenResumeIsByteIdentical) {
+    TempDir tmp("cli_train_resume");
+    const std::string straight = tmp / "straight", split = tmp / "split";
+    const CommandResult a = run_lumigauss(train_args(straight), tmp);
+    ASSERT_EQ(a.exit_code, 0) << a.output;
+
+    const CommandResult b = run_lumigauss(train_args(split, kSchedule + " --stop-after 25"), tmp);
+    ASSERT_EQ(b.exit_code, 0) << b.output;
+    EXPECT_THAT(b.output, HasSubstr("--resume"));
+    EXPECT_EQ(load_checkpoint(split + "/checkpoint.lgck").iteration, 25);
+    // As after a crash between a log line and the next checkpoint: lines past the checkpoint are dropped
+    // on resume.
+    {
+        std::ofstream log(split + "/log.jsonl", std::ios::app);
+        log << R"({"iteration":30,"stage":2,"total":123})" << '\n';
+    }
+    const CommandResult c =
+        run_lumigauss("train " + quoted(tiny_scene()) + " -o " + quoted(split) + " --resume -q", tmp);
+    ASSERT_EQ(c.exit_code, 0) << c.output;
+    EXPECT_THAT(c.output, HasSubstr("resuming"));
+
+    // Every file but the log (which holds timings): model, lighting, checkpoint, photos, config, previews.
+    auto files_a = folder_bytes(straight), files_b = folder_bytes(split);
+    for (const std::string& f : kRunFiles) EXPECT_EQ(files_b.count(f), 1u) << f;
+    files_a.erase("log.jsonl");
+    files_b.erase("log.jsonl");
+    EXPECT_EQ(files_a.size(), files_b.size());
+    for (const auto& [name, bytes] : files_a)
+        EXPECT_TRUE(files_b.count(name) == 1 && files_b.at(name) == bytes)
+            << name << " differs between the straight and the resumed run";
+
+    std::vector<nlohmann::json> log_a = read_log(straight + "/log.jsonl");
+    std::vector<nlohmann::json> log_b = read_log(split + "/log.jsonl");
+    const std::vector<std::int64_t> its = log_iterations(log_b);
+    EXPECT_EQ(std::set<std::int64_t>(its.begin(), its.end()).size(), its.size()) << "duplicated iterations";
+    EXPECT_EQ(its, log_iterations(log_a));
+    ASSERT_EQ(log_a.size(), log_b.size());
+    for (std::size_t i = 0; i < log_a.size(); ++i) {
+        log_a[i].erase("elapsed_s");
+        log_b[i].erase("elapsed_s");
+        EXPECT_EQ(log_a[i], log_b[i]);
+    }
+}
+
+// ---- 9. An existing run is protected ---------------------------------------------------------------------
+
+TEST(CliTrain, ExistingRunNeedsResumeOrForce) {
+    TempDir tmp("cli_train_exists");
+    const std::string run = tmp / "run";
+    const std::string short_run = " --preset fast --iterations 20 --set log_interval=5 -q";
+    ASSERT_EQ(run_lumigauss(train_args(run, short_run), tmp).exit_code, 0);
+    const auto before = folder_bytes(run);
+    for (const std::string& f : kRunFiles) ASSERT_EQ(before.count(f), 1u) << f;
+
+    const CommandResult again = run_lumigauss(train_args(run, short_run), tmp);
+    EXPECT_NE(again.exit_code, 0);
+    EXPECT_THAT(again.output, HasSubstr("--resume"));
+    EXPECT_THAT(again.output, HasSubstr("--force"));
+    EXPECT_THAT(again.output, HasSubstr("checkpoint.lgck"));
+    EXPECT_TRUE(folder_bytes(run) == before) << "a refused run changed the folder";
+
+    const CommandResult forced =
+        run_lumigauss(train_args(run, " --preset fast --iterations 30 --set log_interval=5 -q --force"), tmp);
+    ASSERT_EQ(forced.exit_code, 0) << forced.output;
+    EXPECT_EQ(synth_test::read_json(run + "/config.json")["iterations"], 30);
+    EXPECT_EQ(load_checkpoint(run + "/checkpoint.lgck").iteration, 30);
+    EXPECT_EQ(log_iterations(read_log(run + "/log.jsonl")),
+              (std::vector<std::int64_t>{5, 10, 15, 20, 25, 30}));
+}
+
+// ---- 10. Bad input
+// ------------------------------------------------------------------------------------------
+
+TEST(CliTrain, BadInputFailsNamingTheFileOrKey) {
+    TempDir tmp("cli_train_bad");
+    {
+        const std::string missing = tmp / "no_such_scene";
+        const CommandResult r =
+            run_lumigauss("train " + quoted(missing) + " -o " + quoted(tmp / "run1") + " -q", tmp);
+        EXPECT_NE(r.exit_code, 0);
+        EXPECT_THAT(r.output, HasSubstr("no_such_scene"));
+        EXPECT_FALSE(fs::exists(tmp / "run1/checkpoint.lgck"));
+    }
+    {
+        const CommandResult r = run_lumigauss(train_args(tmp / "run2", " --set lambda_shadoww=3 -q"), tmp);
+        EXPECT_NE(r.exit_code, 0);
+        EXPECT_THAT(r.output, HasSubstr("lambda_shadoww"));
+        EXPECT_FALSE(fs::exists(tmp / "run2"));
+    }
+    {
+        const std::string bad = tmp / "bad_config.json";
+        std::ofstream(bad) << "{ \"iterations\": 10, ";
+        const CommandResult r =
+            run_lumigauss(train_args(tmp / "run3", " --config " + quoted(bad) + " -q"), tmp);
+        EXPECT_NE(r.exit_code, 0);
+        EXPECT_THAT(r.output, HasSubstr(bad));
+        EXPECT_FALSE(fs::exists(tmp / "run3"));
+    }
+    {
+        const std::string run = tmp / "run4";
+        const CommandResult r = run_lumigauss(train_args(run, " --resume -q"), tmp);
+        EXPECT_NE(r.exit_code, 0);
+        EXPECT_THAT(r.output, HasSubstr(run + "/checkpoint.lgck"));
+    }
+}
+
+}  // namespace
+}  // namespace lumigauss
