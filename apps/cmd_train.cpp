@@ -171,7 +171,13 @@ int run_train(const TrainFlags& f) {
         if (!f.config_file.empty() || !f.overrides.empty() || f.downscale > 0)
             throw Error("--resume continues with the saved config; only --iterations may change");
         TrainState state = load_checkpoint(paths.checkpoint);
-        if (f.iterations > 0) state.config.iterations = f.iterations;
+        if (f.iterations > 0) {
+            if (f.iterations < state.iteration)
+                fail_in_file(paths.checkpoint, "the run is already at iteration " +
+                                                   std::to_string(state.iteration) +
+                                                   "; --iterations must not be smaller");
+            state.config.iterations = f.iterations;
+        }
         DatasetOptions dopt;
         dopt.downscale = state.config.downscale;
         const Dataset data = load_dataset(f.scene, dopt);
@@ -184,11 +190,11 @@ int run_train(const TrainFlags& f) {
         if (std::filesystem::exists(paths.checkpoint) && !f.force)
             fail_in_file(paths.checkpoint,
                          "a run already exists here; continue it with --resume or replace it with --force");
-        std::filesystem::create_directories(f.out);
         DatasetOptions dopt;
         dopt.downscale = config.downscale;
         const Dataset data = load_dataset(f.scene, dopt);
         trainer = std::make_unique<Trainer>(load_train_views(data), data.point_xyz, data.point_rgb, config);
+        std::filesystem::create_directories(f.out);  // only once the input is known to be good
         write_file_atomically(paths.config, train_config_to_json(config));
         write_file_atomically(paths.log, "");
         std::printf("train: %zu photos, %zu SfM points, preset %s, %lld iterations -> %s\n",

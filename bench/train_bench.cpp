@@ -2,17 +2,24 @@
 // unshadowed in one 6-channel pass, physical losses), on a real scene with the surfel count raised to a
 // target by jittered copies of the SfM points. Prints a table of per-phase medians in milliseconds.
 //
-// Usage: train_bench SCENE [--surfels N] [--iterations K] [--threads T] [--downscale R]
+// With --checkpoint, the surfels, lighting and optimizer state of a real run (e.g. a paper-preset run on
+// plaza at iteration 6000) replace the synthetic surfel set: trained surfels are smaller, more opaque and lie
+// in the surfaces, which changes the rasterizer's cost a lot.
+//
+// Usage: train_bench SCENE [--surfels N | --checkpoint RUN/checkpoint.lgck] [--iterations K] [--threads T]
+//                          [--downscale R]
 #include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/synth/rng.h"
+#include "lumigauss/train/checkpoint.h"
 #include "lumigauss/train/trainer.h"
 #include "lumigauss/util/error.h"
 
@@ -21,7 +28,7 @@ namespace lg = lumigauss;
 namespace {
 
 struct Args {
-    std::string scene;
+    std::string scene, checkpoint;
     std::size_t surfels = 100000;
     int iterations = 20, threads = 0, downscale = 1;
 };
@@ -40,6 +47,8 @@ Args parse(int argc, char** argv) {
             a.iterations = std::atoi(next());
         else if (s == "--threads")
             a.threads = std::atoi(next());
+        else if (s == "--checkpoint")
+            a.checkpoint = next();
         else if (s == "--downscale")
             a.downscale = std::atoi(next());
         else
@@ -120,26 +129,44 @@ int main(int argc, char** argv) try {
     lg::DatasetOptions dopt;
     dopt.downscale = args.downscale;
     const lg::Dataset data = lg::load_dataset(args.scene, dopt);
-    std::vector<lg::Vec3f> xyz = data.point_xyz, rgb = data.point_rgb;
-    grow_points(xyz, rgb, args.surfels);
     const auto views = lg::load_train_views(data);
 
-    lg::TrainConfig c = lg::train_preset("paper");
-    c.densify_until = 0;         // constant surfel count while timing
-    c.start_regularization = 0;  // normal + distortion losses on, as for most of a run
-    c.iterations = 1000000;
-    lg::TrainConfig stage1 = c, stage3 = c;
-    stage1.warmup = stage1.start_shadowed = 999999;
-    stage3.warmup = stage3.start_shadowed = 1;  // iteration 1 is stage 2; stage 3 from 2 on
-    lg::Trainer t1(views, xyz, rgb, stage1);
-    lg::Trainer t3(views, xyz, rgb, stage3);
-    t3.step();  // the stage-2 iteration
-    const auto m1 = measure(t1, args.iterations);
-    const auto m3 = measure(t3, args.iterations);
+    // Stage 1 and stage 3 copies of one setup, with densification off so the surfel count stays fixed.
+    auto configure = [](lg::TrainConfig c, bool shadowed) {
+        c.densify_until = 0;
+        c.start_regularization = 0;  // normal + distortion losses on, as for most of a run
+        c.iterations = 1000000;
+        c.warmup = c.start_shadowed = shadowed ? 1 : 999999;  // shadowed: iteration 1 is stage 2, then 3
+        return c;
+    };
+    std::unique_ptr<lg::Trainer> t1, t3;
+    std::size_t surfels = args.surfels;
+    if (!args.checkpoint.empty()) {
+        lg::TrainState state = lg::load_checkpoint(args.checkpoint);
+        surfels = state.model.size();
+        const lg::TrainConfig saved = state.config;
+        lg::TrainState copy = state;
+        state.config = configure(saved, false);
+        copy.config = configure(saved, true);
+        state.iteration = copy.iteration = 0;
+        t1 = std::make_unique<lg::Trainer>(views, std::move(state));
+        t3 = std::make_unique<lg::Trainer>(views, std::move(copy));
+    } else {
+        std::vector<lg::Vec3f> xyz = data.point_xyz, rgb = data.point_rgb;
+        grow_points(xyz, rgb, args.surfels);
+        const lg::TrainConfig c = lg::train_preset("paper");
+        t1 = std::make_unique<lg::Trainer>(views, xyz, rgb, configure(c, false));
+        t3 = std::make_unique<lg::Trainer>(views, xyz, rgb, configure(c, true));
+    }
+    t3->step();  // the stage-2 iteration
+    const auto m1 = measure(*t1, args.iterations);
+    const auto m3 = measure(*t3, args.iterations);
 
-    std::printf("scene %s, %dx%d, %zu surfels, %zu photos, median of %d iterations (ms)\n",
-                args.scene.c_str(), views[0].camera.width, views[0].camera.height, args.surfels, views.size(),
-                args.iterations);
+    std::printf(
+        "scene %s, %dx%d, %zu surfels (%s), %zu photos, median of %d iterations (ms)\n", args.scene.c_str(),
+        views[0].camera.width, views[0].camera.height, surfels,
+        args.checkpoint.empty() ? "SfM points + jittered copies, opacity 0.1" : args.checkpoint.c_str(),
+        views.size(), args.iterations);
     std::printf("%-24s %10s %10s\n", "phase", "stage 1", "stage 3");
     for (int p = 0; p < kPhases; ++p)
         std::printf("%-24s %10.2f %10.2f\n", kPhaseNames[p], m1[std::size_t(p)], m3[std::size_t(p)]);

@@ -53,7 +53,7 @@ LG_HD constexpr Vec3<T> albedo_activation(Vec3<T> raw) {
     Vec3<T> r;
     for (int c = 0; c < 3; ++c) {
         const T v = T(sh_const::kY00) * raw[c] + T(surfel_const::kAlbedoOffset);
-        r[c] = v > T(0) ? v : T(0);
+        r[c] = v <= T(0) ? T(0) : v;  // NaN passes through, as torch's clamp: the loss then reports it
     }
     return r;
 }
@@ -74,14 +74,14 @@ LG_HD constexpr Vec3<T> albedo_activation_vjp(Vec3<T> raw, Vec3<T> g_albedo) {
 template <typename T>
 LG_HD inline T light_intensity(T h) {
     const T floor = T(surfel_const::kIrradianceFloor);
-    return std::pow(h > floor ? h : floor, T(surfel_const::kInvGamma));
+    return std::pow(h < floor ? floor : h, T(surfel_const::kInvGamma));  // NaN passes through
 }
 
 // 3.4, in the official order: clamp_min(H, 1e-5) -> ^(1/2.2) -> * albedo -> clamp_min(0).
 template <typename T>
 LG_HD inline T light_to_colour(T h, T albedo) {
     const T p = albedo * light_intensity(h);
-    return p > T(0) ? p : T(0);
+    return p < T(0) ? T(0) : p;  // NaN passes through
 }
 
 // Backward of light_to_colour; returns dL/dh and adds dL/dalbedo into g_albedo. torch's clamp_min passes

@@ -8,6 +8,7 @@
 
 #include "lumigauss/render/cpu/multiversion.h"
 #include "lumigauss/synth/rng.h"
+#include "lumigauss/util/error.h"
 
 namespace lumigauss {
 namespace {
@@ -75,7 +76,8 @@ inline void run_samples_impl(LaneBatch& b, int samples) {
                 1.0f / (std::sqrt(ux * ux + uy * uy + uz * uz) + float(surfel_const::kDirectionEps));
             const float x = ux * inv, y = uy * inv, z = uz * inv;
             // sh_basis (shading/sh.h) spelled out in scalars: a local array in this loop defeats GCC's
-            // vectoriser. The TrainPhysicalLosses tests compare against the reference per-surfel sums.
+            // vectoriser. TrainPhysicalLosses checks the results against known answers and the
+            // expectation over cube-normalised directions.
             using namespace sh_const;
             const float basis[kShCount] = {float(kY00),
                                            float(kY1) * y,
@@ -127,6 +129,8 @@ TransferLossResult model_transfer_losses(GaussianModel& model, const ViewNormals
                                          std::uint64_t seed, std::int64_t iteration,
                                          const TransferLossWeights<double>& weights, bool backward) {
     const std::size_t n = model.size();
+    if (normals.normal.size() != n || normals.positive_side.size() != n)
+        throw Error("model_transfer_losses: normals were computed for another model size");
     const std::size_t chunks = (n + kChunk - 1) / kChunk;
     const auto& pos = model.param(ModelParam::TransferPositive);
     const auto& neg = model.param(ModelParam::TransferNegative);
@@ -209,7 +213,7 @@ double env_nonnegativity_loss(const ShCoeffs<float>& env, int samples, std::uint
     for (const auto& d : dirs) {
         const Vec3<double> v = eval_sh(sh, d);
         for (int c = 0; c < 3; ++c)
-            if (v[c] < 0) sum += v[c] * v[c], ++count;
+            if (!(v[c] >= 0)) sum += v[c] * v[c], ++count;  // NaN counts, so the loss reports it
     }
     if (count == 0) return 0.0;
     const double loss = sum / double(count);

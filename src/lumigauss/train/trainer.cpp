@@ -169,6 +169,15 @@ Trainer::Trainer(std::vector<TrainView> views, TrainState state)
         if (views_[i].name != state_.image_names[i])
             throw Error("the saved run's training photo " + std::to_string(i) + " is '" +
                         state_.image_names[i] + "', the dataset's is '" + views_[i].name + "'");
+    // A saved state with NaN/Inf would fail at once or, worse, silently keep the bad surfels: refuse it.
+    for (int p = 0; p < kModelParamCount; ++p)
+        if (!all_finite(state_.model.param(ModelParam(p))))
+            throw Error(std::string("the saved run's surfel parameter '") +
+                        GaussianModel::name(ModelParam(p)) + "' holds NaN or Inf values");
+    for (int g = 0; g < kMlpGroupCount; ++g)
+        if (!all_finite(state_.lighting.param(MlpGroup(g))))
+            throw Error(std::string("the saved run's lighting parameter '") + mlp_group_name(MlpGroup(g)) +
+                        "' holds NaN or Inf values");
 }
 
 Trainer::~Trainer() = default;

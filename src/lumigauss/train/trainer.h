@@ -43,7 +43,7 @@ const char* stage_name(Stage stage);
 struct StepReport {
     std::int64_t iteration = 0;
     Stage stage = Stage::Unshadowed;
-    int view = -1;  // index into the training views (-1: none rendered)
+    int view = -1;  // index into the training views: rendered, or (stage 2) whose camera picks the normals
     double total = 0;
     double l1_shadowed = 0, dssim_shadowed = 0;
     double l1_unshadowed = 0, dssim_unshadowed = 0;

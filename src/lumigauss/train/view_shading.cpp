@@ -116,6 +116,8 @@ ShCoeffs<float> shade_surfels_backward(GaussianModel& model, const ShCoeffs<floa
                                        const ViewNormals& normals, std::span<const float> g_colors) {
     const std::size_t n = model.size();
     const int channels = shading_channels(mode);
+    if (normals.normal.size() != n || normals.positive_side.size() != n)
+        throw Error("shade_surfels_backward: normals were computed for another model size");
     if (g_colors.size() != n * std::size_t(channels))
         throw Error("shade_surfels_backward: colour gradient has the wrong size");
     std::span<float> g_albedo = model.grad(ModelParam::Albedo);
