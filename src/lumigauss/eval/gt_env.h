@@ -1,0 +1,165 @@
+#pragma once
+// The `gt-env` evaluation protocol: a trained run against a scene that ships its true lighting, in the
+// layout of data/plaza (and of what `lumigauss synth` writes): meta.json (per image: name, split, condition,
+// exposure), env/COND_sh.txt (true radiance SH of each condition) and, optionally, gt/{mask,albedo,normal}.
+//
+// 1. Light scale. The model shades albedo_m * max(E_m, 1e-5)^(1/2.2) (shading/surfel_shading.h), and a photo
+//    is srgb(exposure * rho/pi * E_true) (data/plaza README). Since srgb(x) ~ x^(1/2.2), the fit has a gauge:
+//    albedo_m * c with E_m * c^(-2.2) renders the same, so the learned SH of training photo i is, at best,
+//    k * exposure_i * (true SH of its condition) for ONE unknown k shared by all photos. k is estimated from
+//    the TRAINING photos only (learned SH from the lighting MLP, true SH from meta.json), never from a test
+//    photo, as the least-squares fit of the irradiance over the whole sphere of normals:
+//        k = argmin sum_i integral_{S^2} |E[L_i](n) - k e_i E[T_i](n)|^2 dn
+//          = sum_i e_i sum_{j,c} A_l(j)^2 L_ijc T_ijc  /  sum_i e_i^2 sum_{j,c} A_l(j)^2 T_ijc^2,
+//    (orthonormality of the SH turns the integral into the A_l^2-weighted sum over the 27 coefficients;
+//    A_0 = pi, A_1 = 2pi/3, A_2 = pi/4), so band 0 and 1, which carry most of the irradiance, dominate.
+// 2. Each test photo is rendered under env = k * exposure_test * (true SH of its condition): no rotation
+//    search, no per-image colour fit. Using the test photo's exposure is allowed: it is the camera's setting
+//    (recorded with the photo, like EXIF), not a property of the lighting; the data sets fix it to 1.0 for
+//    test photos anyway.
+// 3. Image metrics (eval/metrics.h, official formulas) of the render clamped to [0, 1] against the photo,
+//    shadowed and unshadowed, under the evaluation mask: gt/mask (geometry coverage) eroded once with 5x5
+//    and kept where fully covered, times the scene's own mask (masks/, binarised at 0.5) if it has one.
+//    Without gt/mask the scene's mask alone is eroded and binarised the same way.
+// 4. Albedo (when gt/albedo exists): the model's albedo max(0, Y00 a + 0.5) rasterised with its geometry
+//    (black background). That albedo lives in the model's gamma-2.2 domain (it multiplies E^(1/2.2)), so it
+//    is compared (a) linearised, a^2.2, against gt/albedo ("albedo", primary) and (b) as it is against
+//    gt/albedo^(1/2.2) ("albedo_gamma"), each after ONE per-channel least-squares scale pooled over all test
+//    images' masked pixels, then clamped to [0, 1]; PSNR/MSE/MAE with the official formulas.
+// 5. Normals (when gt/normal exists): the rasterised world normal map, normalised, against gt/normal decoded
+//    as 2v - 1 and normalised; angles in degrees over the evaluation mask; a pixel with no rendered normal
+//    counts as 90 deg. Per image mean and median; overall the mean of those and the pooled statistics.
+// Ground-truth images are area-resampled to the evaluated resolution (-r) like the photos.
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "lumigauss/eval/metrics.h"
+#include "lumigauss/io/dataset.h"
+#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/scene/splat_ply.h"
+#include "lumigauss/shading/sh.h"
+
+namespace lumigauss {
+
+// ---- The scene's ground truth ---------------------------------------------------------------------------
+
+struct GtImageMeta {
+    std::string name, split, condition;
+    double exposure = 1.0;
+};
+
+struct GtSceneMeta {
+    std::string root, meta_path;
+    std::vector<GtImageMeta> images;
+    std::map<std::string, std::string>
+        condition_sh;  // condition id -> SH file ("sh" of meta.json conditions)
+
+    const GtImageMeta* find(const std::string& name) const;  // nullptr if absent
+    // The SH file of a condition: meta.json's "sh" entry of it, else env/COND_sh.txt.
+    std::string sh_path(const std::string& condition) const;
+};
+
+// Reads <root>/meta.json. Throws Error naming the file if it is missing or malformed.
+GtSceneMeta load_gt_scene_meta(const std::string& scene_root);
+// The true radiance SH of a condition; throws Error naming the SH file if it is missing or malformed.
+ShCoeffs<double> load_condition_sh(const GtSceneMeta& meta, const std::string& condition);
+
+// ---- The trained run ------------------------------------------------------------------------------------
+
+struct RelightableRun {
+    std::string dir;
+    GaussianModel model;
+    std::vector<std::string> image_names;      // appearance.json, in embedding order
+    std::vector<ShCoeffs<double>> learned_sh;  // the lighting MLP's env_sh(i) of each of them
+    int downscale = 0;                         // config.json "downscale"; 0 if unknown
+};
+
+// model.ply, lighting.lgmlp, appearance.json (and config.json if present) of a run folder. Throws Error
+// naming the first missing or malformed file.
+RelightableRun load_relightable_run(const std::string& dir);
+
+// A relightable model with the geometry and colour of a 2DGS surfel model (e.g. gt/surfels.ply, whose colour
+// is the linear albedo rho): model albedo = (rho / pi)^(1/2.2), so that with learned SH = exposure * true SH
+// (light scale 1) its unshadowed colour is (exposure rho/pi E)^(1/2.2), the photo up to the sRGB curve; both
+// transfer sets are the cosine lobes of their side's normal (unoccluded: shadowed == unshadowed).
+GaussianModel relightable_from_surfels(const ViewDependentSurfels& surfels);
+
+// ---- Light scale ----------------------------------------------------------------------------------------
+
+// A_l(j)^2, the weight of coefficient j in the irradiance least squares.
+double irradiance_weight(int j);
+
+struct LightScaleFit {
+    double scale = 1.0;              // k
+    double relative_residual = 0.0;  // sqrt(sum w |L - k e T|^2 / sum w |L|^2)
+    std::vector<std::string> names;  // the training photos used
+    std::vector<double> per_photo;   // each photo's own least-squares k_i (diagnostic)
+};
+
+// The global k of (1) above from matched lists. Throws Error when the lists are empty, differ in length, or
+// the true lighting is all zero.
+LightScaleFit fit_light_scale(const std::vector<ShCoeffs<double>>& learned,
+                              const std::vector<ShCoeffs<double>>& truth, const std::vector<double>& exposure,
+                              const std::vector<std::string>& names = {});
+
+// The run's training photos found in meta.json with split "train" and not in `exclude` (evaluate_gt_env
+// passes the test views it evaluates): a test photo never enters the fit. Throws Error naming meta.json
+// when no photo is left.
+LightScaleFit fit_run_light_scale(const RelightableRun& run, const GtSceneMeta& meta,
+                                  const std::vector<std::string>& exclude = {});
+
+// ---- The protocol ---------------------------------------------------------------------------------------
+
+struct AlbedoMetrics {
+    double psnr = 0, mse = 0, mae = 0;
+};
+
+// What the contact sheet shows, at the evaluated resolution (3 channels each unless noted).
+struct GtEnvPanels {
+    Image truth, shadowed, unshadowed;  // photo and clamped renders
+    Image albedo;                       // model albedo, gamma domain, scaled and clamped (empty: no gt)
+    Image normal;                       // rendered normals encoded (n + 1)/2, black where nothing rendered
+    Image shadow;                       // 1 channel: luminance shadowed / unshadowed, clamped to [0, 1]
+    Image mask;                         // 1 channel: the evaluation mask
+    Image gt_albedo, gt_normal;         // gt/albedo^(1/2.2) and gt/normal as stored (empty when absent)
+    Image normal_error;                 // 1 channel: angle / 45 deg on the mask (empty when no gt/normal)
+};
+
+struct GtEnvImageResult {
+    std::string name, condition;
+    double exposure = 1.0;
+    std::size_t mask_pixels = 0;
+    ImageMetrics shadowed, unshadowed;
+    bool has_albedo = false, has_normal = false;
+    AlbedoMetrics albedo, albedo_gamma;
+    AngularErrorStats normal;
+    GtEnvPanels panels;
+};
+
+struct GtEnvResult {
+    LightScaleFit light;
+    int downscale = 1;
+    bool gt_mask = false;                         // every test image had a gt/mask
+    bool has_albedo = false, has_normal = false;  // every test image had gt/albedo, gt/normal
+    std::vector<GtEnvImageResult> images;
+    // Means over images (PSNR averaged as PSNR, as officially).
+    ImageMetrics mean_shadowed, mean_unshadowed;
+    std::array<double, 3> albedo_scale{1, 1, 1}, albedo_gamma_scale{1, 1, 1};
+    AlbedoMetrics mean_albedo, mean_albedo_gamma;
+    AngularErrorStats mean_normal;    // mean of the per-image means and of the per-image medians
+    AngularErrorStats pooled_normal;  // over every measured pixel of every test image
+};
+
+struct GtEnvOptions {
+    SsimOptions ssim;  // win 5, as the official evaluation
+    bool keep_panels = true;
+};
+
+// Runs the protocol on every test view of `scene` (loaded at the resolution to evaluate). Throws Error
+// naming the file for a test photo missing from meta.json, a missing SH file, or an empty evaluation mask.
+GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, const GtSceneMeta& meta,
+                            const GtEnvOptions& options = {});
+
+}  // namespace lumigauss

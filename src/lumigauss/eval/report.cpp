@@ -1,0 +1,235 @@
+#include "lumigauss/eval/report.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "lumigauss/io/atomic_file.h"
+#include "lumigauss/io/image.h"
+
+namespace lumigauss {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+Json number(double v) {
+    return std::isfinite(v) ? Json(v) : Json(nullptr);
+}
+
+Json metrics_json(const ImageMetrics& m) {
+    return Json{
+        {"psnr", number(m.psnr)}, {"ssim", number(m.ssim)}, {"mse", number(m.mse)}, {"mae", number(m.mae)}};
+}
+
+Json albedo_json(const AlbedoMetrics& m) {
+    return Json{{"psnr", number(m.psnr)}, {"mse", number(m.mse)}, {"mae", number(m.mae)}};
+}
+
+Json normal_json(const AngularErrorStats& s, bool with_counts = true) {
+    Json j{{"mean_deg", number(s.mean_deg)}, {"median_deg", number(s.median_deg)}};
+    if (with_counts) j["pixels"] = s.pixels, j["missing"] = s.missing;
+    return j;
+}
+
+Json rgb_json(const std::array<double, 3>& v) {
+    return Json::array({number(v[0]), number(v[1]), number(v[2])});
+}
+
+std::string fmt(const char* f, double v) {
+    if (!std::isfinite(v)) return "n/a";
+    char buf[64];
+    std::snprintf(buf, sizeof buf, f, v);
+    return buf;
+}
+
+// The sheet file of an image: sheets/<name without extension>.png (folders in the name kept).
+std::string sheet_relative_path(const std::string& image_name) {
+    fs::path p = fs::path("sheets") / image_name;
+    p.replace_extension(".png");
+    return p.generic_string();
+}
+
+void paste(Image& sheet, const Image& panel, int x0, int y0, int w, int h, double gain = 1.0) {
+    if (panel.empty() || panel.width != w || panel.height != h) return;  // left black
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const float v = panel.at(x, y, panel.channels == 1 ? 0 : c);
+                sheet.at(x0 + x, y0 + y, c) = float(std::min(1.0, std::max(0.0, gain * double(v))));
+            }
+}
+
+Image abs_difference(const Image& a, const Image& b) {
+    if (a.empty() || b.empty() || a.pixels.size() != b.pixels.size()) return {};
+    Image d = a;
+    for (std::size_t i = 0; i < d.pixels.size(); ++i) d.pixels[i] = std::abs(a.pixels[i] - b.pixels[i]);
+    return d;
+}
+
+}  // namespace
+
+nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSources& src) {
+    Json j;
+    j["protocol"] = "gt-env";
+    j["run"] = src.run;
+    j["scene"] = src.scene;
+    j["downscale"] = r.downscale;
+    Json per_photo = Json::object();
+    for (std::size_t i = 0; i < r.light.per_photo.size() && i < r.light.names.size(); ++i)
+        per_photo[r.light.names[i]] = number(r.light.per_photo[i]);
+    j["light_scale"] = {
+        {"value", number(r.light.scale)},
+        {"method",
+         "least squares of the irradiance over the sphere of normals, learned SH of the training photos vs "
+         "scale * exposure * true SH (coefficients weighted by A_l^2); training photos only"},
+        {"train_photos", r.light.per_photo.size()},
+        {"relative_residual", number(r.light.relative_residual)},
+        {"per_photo", per_photo}};
+    j["test_exposure"] = "each test photo's meta.json exposure (its camera setting, not lighting) is applied";
+    j["mask"] = r.gt_mask ? "gt/mask eroded 5x5 once, full coverage only, times the scene mask"
+                          : "scene mask eroded 5x5 once, full coverage only (no gt/mask)";
+    if (r.has_albedo)
+        j["albedo_scale"] = {{"linear", rgb_json(r.albedo_scale)}, {"gamma", rgb_json(r.albedo_gamma_scale)}};
+    Json images = Json::array();
+    for (const GtEnvImageResult& im : r.images) {
+        Json e;
+        e["name"] = im.name;
+        e["condition"] = im.condition;
+        e["exposure"] = im.exposure;
+        e["mask_pixels"] = im.mask_pixels;
+        e["shadowed"] = metrics_json(im.shadowed);
+        e["unshadowed"] = metrics_json(im.unshadowed);
+        if (im.has_albedo)
+            e["albedo"] = albedo_json(im.albedo), e["albedo_gamma"] = albedo_json(im.albedo_gamma);
+        if (im.has_normal) e["normal"] = normal_json(im.normal);
+        images.push_back(std::move(e));
+    }
+    j["images"] = images;
+    Json mean;
+    mean["shadowed"] = metrics_json(r.mean_shadowed);
+    mean["unshadowed"] = metrics_json(r.mean_unshadowed);
+    if (r.has_albedo)
+        mean["albedo"] = albedo_json(r.mean_albedo), mean["albedo_gamma"] = albedo_json(r.mean_albedo_gamma);
+    if (r.has_normal) mean["normal"] = normal_json(r.mean_normal, false);
+    j["mean"] = mean;
+    if (r.has_normal) j["normal_all_pixels"] = normal_json(r.pooled_normal);
+    return j;
+}
+
+std::string gt_env_report_markdown(const GtEnvResult& r, const ReportSources& src, bool with_sheets) {
+    std::string s = "# Evaluation: gt-env\n\n";
+    s += "- run: `" + src.run + "`\n- scene: `" + src.scene + "`\n";
+    s += "- resolution: downscale " + std::to_string(r.downscale) + ", " + std::to_string(r.images.size()) +
+         " test images\n\n";
+    s += "## Protocol\n\n";
+    s += "- Each test photo is rendered under `k * exposure * (true SH of its condition)`: no rotation "
+         "search, "
+         "no per-image colour fit.\n";
+    s += "- `k` = " + fmt("%.6g", r.light.scale) +
+         ", the one global scale between the model's light and the true light (the model's albedo/light "
+         "gauge), fitted on the " +
+         std::to_string(r.light.per_photo.size()) +
+         " **training** photos only: least squares of the irradiance over the sphere of normals between "
+         "their learned SH and `k * exposure * true SH` (SH coefficients weighted by A_l^2). Relative "
+         "residual " +
+         fmt("%.3f", r.light.relative_residual) + ".\n";
+    s += "- The test photo's exposure (meta.json) is applied: it is the camera's setting, recorded with the "
+         "photo, not lighting (1.0 for the test photos of data/plaza and `lumigauss synth`).\n";
+    s += std::string("- Mask: ") +
+         (r.gt_mask ? "`gt/mask` eroded once with 5x5, fully covered pixels only, times the scene's mask"
+                    : "the scene's mask eroded once with 5x5 (no `gt/mask`)") +
+         ".\n";
+    s += "- Metrics (official): MSE = sum m (x-y)^2 / (3 sum m + 1e-6), MAE likewise, PSNR = -10 log10(MSE + "
+         "1e-6), SSIM = skimage `structural_similarity` (5x5 uniform window, sample covariance, data range "
+         "1) averaged over the mask; renders clamped to [0, 1]; means are over images (PSNR averaged as "
+         "PSNR).\n";
+    if (r.has_albedo)
+        s += "- Albedo: the model's albedo rasterised; *linear* = albedo^2.2 vs `gt/albedo`, *gamma* = "
+             "albedo vs "
+             "`gt/albedo`^(1/2.2), each after one per-channel least-squares scale over all test images "
+             "(linear " +
+             fmt("%.4g", r.albedo_scale[0]) + " " + fmt("%.4g", r.albedo_scale[1]) + " " +
+             fmt("%.4g", r.albedo_scale[2]) + ", gamma " + fmt("%.4g", r.albedo_gamma_scale[0]) + " " +
+             fmt("%.4g", r.albedo_gamma_scale[1]) + " " + fmt("%.4g", r.albedo_gamma_scale[2]) + ").\n";
+    if (r.has_normal)
+        s += "- Normals: rendered world normals vs `gt/normal` on the mask; a pixel with nothing rendered "
+             "counts "
+             "as 90 deg.\n";
+    s += "\n## Summary (mean over test images)\n\n";
+    s += "| | PSNR | SSIM | MSE | MAE |\n| --- | --- | --- | --- | --- |\n";
+    auto row = [](const std::string& label, const ImageMetrics& m) {
+        return "| " + label + " | " + fmt("%.2f", m.psnr) + " | " + fmt("%.4f", m.ssim) + " | " +
+               fmt("%.5f", m.mse) + " | " + fmt("%.4f", m.mae) + " |\n";
+    };
+    s += row("shadowed", r.mean_shadowed) + row("unshadowed", r.mean_unshadowed);
+    if (r.has_albedo) {
+        s += "| albedo (linear) | " + fmt("%.2f", r.mean_albedo.psnr) + " | | " +
+             fmt("%.5f", r.mean_albedo.mse) + " | " + fmt("%.4f", r.mean_albedo.mae) + " |\n";
+        s += "| albedo (gamma) | " + fmt("%.2f", r.mean_albedo_gamma.psnr) + " | | " +
+             fmt("%.5f", r.mean_albedo_gamma.mse) + " | " + fmt("%.4f", r.mean_albedo_gamma.mae) + " |\n";
+    }
+    if (r.has_normal)
+        s += "\nNormal angular error: mean " + fmt("%.2f", r.mean_normal.mean_deg) + " deg, median " +
+             fmt("%.2f", r.mean_normal.median_deg) +
+             " deg (means of the per-image values); over all pixels: mean " +
+             fmt("%.2f", r.pooled_normal.mean_deg) + ", median " + fmt("%.2f", r.pooled_normal.median_deg) +
+             " deg.\n";
+    s += "\n## Per image\n\n| image | condition | exposure | PSNR sh. | SSIM sh. | PSNR unsh. | SSIM unsh. | "
+         "albedo PSNR | normal mean / median |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    for (const GtEnvImageResult& im : r.images)
+        s += "| " + im.name + " | " + im.condition + " | " + fmt("%.3f", im.exposure) + " | " +
+             fmt("%.2f", im.shadowed.psnr) + " | " + fmt("%.4f", im.shadowed.ssim) + " | " +
+             fmt("%.2f", im.unshadowed.psnr) + " | " + fmt("%.4f", im.unshadowed.ssim) + " | " +
+             (im.has_albedo ? fmt("%.2f", im.albedo.psnr) : "n/a") + " | " +
+             (im.has_normal ? fmt("%.1f", im.normal.mean_deg) + " / " + fmt("%.1f", im.normal.median_deg)
+                            : "n/a") +
+             " |\n";
+    if (with_sheets) {
+        s += "\n## Contact sheets\n\nTop: photo | shadowed | unshadowed | albedo | normals | shadow "
+             "(shadowed / unshadowed). Bottom: mask | shadowed error x4 | unshadowed error x4 | ground-truth "
+             "albedo | ground-truth normals | normal error (white = 45 deg or more).\n\n";
+        for (const GtEnvImageResult& im : r.images)
+            s += "### " + im.name + "\n\n![" + im.name + "](" + sheet_relative_path(im.name) + ")\n\n";
+    }
+    return s;
+}
+
+Image gt_env_contact_sheet(const GtEnvImageResult& im) {
+    const GtEnvPanels& p = im.panels;
+    const int w = p.truth.width, h = p.truth.height, gap = 2;
+    Image sheet(6 * w + 5 * gap, 2 * h + gap, 3, 1.0f);
+    const Image* top[6] = {&p.truth, &p.shadowed, &p.unshadowed, &p.albedo, &p.normal, &p.shadow};
+    const Image err_s = abs_difference(p.shadowed, p.truth), err_u = abs_difference(p.unshadowed, p.truth);
+    const Image* bottom[6] = {&p.mask, &err_s, &err_u, &p.gt_albedo, &p.gt_normal, &p.normal_error};
+    const double gains[6] = {1, 4, 4, 1, 1, 1};
+    for (int i = 0; i < 6; ++i) {
+        const int x0 = i * (w + gap);
+        for (int row = 0; row < 2; ++row)
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x)
+                    for (int c = 0; c < 3; ++c) sheet.at(x0 + x, row * (h + gap) + y, c) = 0.0f;
+        paste(sheet, *top[i], x0, 0, w, h);
+        paste(sheet, *bottom[i], x0, h + gap, w, h, gains[i]);
+    }
+    return sheet;
+}
+
+void write_gt_env_report(const std::string& dir, const GtEnvResult& result, const ReportSources& sources,
+                         bool with_sheets) {
+    fs::create_directories(dir);
+    bool sheets = with_sheets && !result.images.empty();
+    for (const GtEnvImageResult& im : result.images) sheets = sheets && !im.panels.truth.empty();
+    if (sheets)
+        for (const GtEnvImageResult& im : result.images) {
+            const fs::path path = fs::path(dir) / sheet_relative_path(im.name);
+            fs::create_directories(path.parent_path());
+            write_png(path.string(), gt_env_contact_sheet(im));
+        }
+    write_file_atomically((fs::path(dir) / "metrics.json").string(),
+                          gt_env_metrics_json(result, sources).dump(2) + "\n");
+    write_file_atomically((fs::path(dir) / "report.md").string(),
+                          gt_env_report_markdown(result, sources, sheets));
+}
+
+}  // namespace lumigauss

@@ -1,0 +1,147 @@
+// `lumigauss eval`: on a short training run of the tiny synthetic scene it writes metrics.json (every key),
+// report.md and one contact sheet per test image; a run folder without model.ply and a scene without
+// meta.json fail with a message naming the file.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "lumigauss/io/dataset.h"
+#include "lumigauss/io/image.h"
+#include "synth_test_util.h"
+
+namespace lumigauss {
+namespace {
+
+using synth_test::TempDir;
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+struct CommandResult {
+    int exit_code = -1;
+    std::string output;
+};
+
+CommandResult run_lumigauss(const std::string& args, const TempDir& tmp) {
+    const std::string out = tmp.sub("output.txt");
+    const std::string command = std::string("'") + LUMIGAUSS_BINARY + "' " + args + " > '" + out + "' 2>&1";
+    const int status = std::system(command.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, synth_test::read_bytes(out)};
+}
+
+std::string shell_quoted(const std::string& s) {
+    return "'" + s + "'";
+}
+
+// The tiny scene and a 50-iteration run on it, made once per test process.
+struct TinyRun {
+    TempDir dir{"cli_eval"};
+    std::string scene = dir / "scene", run = dir / "run";
+    std::string train_output;
+    int train_exit = -1;
+    TinyRun() {
+        synth::generate_synthetic_scene(synth_test::tiny_options(scene));
+        const CommandResult r = run_lumigauss(
+            "train " + shell_quoted(scene) + " -o " + shell_quoted(run) + " --preset fast --iterations 50 -q",
+            dir);
+        train_exit = r.exit_code;
+        train_output = r.output;
+    }
+};
+
+const TinyRun& tiny_run() {
+    static TinyRun r;
+    return r;
+}
+
+TEST(CliEval, WritesMetricsReportAndContactSheets) {
+    const TinyRun& t = tiny_run();
+    ASSERT_EQ(t.train_exit, 0) << t.train_output;
+    TempDir tmp("cli_eval_report");
+    const std::string report = tmp / "report";
+    const CommandResult r =
+        run_lumigauss("eval " + shell_quoted(t.run) + " --scene " + shell_quoted(t.scene) +
+                          " --protocol gt-env -o " + shell_quoted(report),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("light scale"));
+    EXPECT_THAT(r.output, HasSubstr("metrics.json"));
+
+    const nlohmann::json j = synth_test::read_json(report + "/metrics.json");
+    EXPECT_EQ(j["protocol"], "gt-env");
+    EXPECT_EQ(j["downscale"], 1);
+    EXPECT_TRUE(j["light_scale"]["value"].is_number());
+    EXPECT_EQ(j["light_scale"]["train_photos"], 8);  // the tiny preset's training photos
+    EXPECT_TRUE(j["albedo_scale"]["linear"].is_array());
+    const Dataset scene = load_dataset(t.scene);
+    const auto tests = scene.split(Split::Test);
+    ASSERT_EQ(j["images"].size(), tests.size());
+    for (std::size_t i = 0; i < tests.size(); ++i) {
+        const nlohmann::json& im = j["images"][i];
+        EXPECT_EQ(im["name"], tests[i]->name);
+        for (const char* mode : {"shadowed", "unshadowed"})
+            for (const char* key : {"psnr", "ssim", "mse", "mae"})
+                EXPECT_TRUE(im[mode][key].is_number()) << mode << "." << key << " in " << im.dump();
+        for (const char* key : {"psnr", "mse", "mae"}) {
+            EXPECT_TRUE(im["albedo"][key].is_number()) << key;
+            EXPECT_TRUE(im["albedo_gamma"][key].is_number()) << key;
+        }
+        EXPECT_TRUE(im["normal"]["mean_deg"].is_number());
+        EXPECT_TRUE(im["normal"]["median_deg"].is_number());
+        EXPECT_GT(im["mask_pixels"].get<int>(), 0);
+        const double psnr = im["shadowed"]["psnr"];
+        EXPECT_GT(psnr, 3.0);
+        EXPECT_LE(psnr, 60.0);
+        // The contact sheet: two rows of six panels.
+        fs::path sheet = fs::path(report) / "sheets" / tests[i]->name;
+        sheet.replace_extension(".png");
+        ASSERT_TRUE(fs::exists(sheet)) << sheet;
+        const ImageInfo info = read_image_info(sheet.string());
+        EXPECT_EQ(info.width, 6 * tests[i]->camera.width + 10);
+        EXPECT_EQ(info.height, 2 * tests[i]->camera.height + 2);
+    }
+    for (const char* mode : {"shadowed", "unshadowed", "albedo", "albedo_gamma", "normal"})
+        EXPECT_TRUE(j["mean"].contains(mode)) << mode;
+    const std::string md = synth_test::read_bytes(report + "/report.md");
+    EXPECT_THAT(md, HasSubstr("gt-env"));
+    EXPECT_THAT(md, HasSubstr("training"));
+    EXPECT_THAT(md, HasSubstr("sheets/" + fs::path(tests[0]->name).stem().string() + ".png"));
+}
+
+TEST(CliEval, MissingModelIsNamed) {
+    const TinyRun& t = tiny_run();
+    ASSERT_EQ(t.train_exit, 0) << t.train_output;
+    TempDir tmp("cli_eval_no_model");
+    const std::string run = tmp / "run";
+    fs::create_directories(run);
+    for (const char* f : {"config.json", "lighting.lgmlp", "appearance.json"})
+        fs::copy_file(t.run + "/" + f, run + "/" + f);
+    const CommandResult r = run_lumigauss("eval " + shell_quoted(run) + " --scene " + shell_quoted(t.scene) +
+                                              " -o " + shell_quoted(tmp / "report"),
+                                          tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr(run + "/model.ply"));
+    EXPECT_FALSE(fs::exists(tmp / "report/metrics.json"));
+}
+
+TEST(CliEval, SceneWithoutGroundTruthIsNamed) {
+    const TinyRun& t = tiny_run();
+    ASSERT_EQ(t.train_exit, 0) << t.train_output;
+    TempDir tmp("cli_eval_no_meta");
+    const CommandResult r =
+        run_lumigauss("eval " + shell_quoted(t.run) + " --scene " + shell_quoted(tmp / "nothing") + " -o " +
+                          shell_quoted(tmp / "report"),
+                      tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr(tmp / "nothing/meta.json"));
+    const CommandResult bad = run_lumigauss(
+        "eval " + shell_quoted(t.run) + " --scene " + shell_quoted(t.scene) + " --protocol nerf-osr", tmp);
+    EXPECT_NE(bad.exit_code, 0);
+}
+
+}  // namespace
+}  // namespace lumigauss
