@@ -139,6 +139,20 @@ LG_HD inline bool project_surfel(const SurfelGeometry<T>& g, T opacity, const Pi
     // the camera) centres the filter instead.
     out.center = out.conic_center ? conic_box(out.tu, out.tv, out.tw, c2, d3).center
                                   : Vec2<T>{out.tu.z / out.tw.z, out.tv.z / out.tw.z};
+    // Near the boundary of that case (d3 -> 0-) the conic centre runs off to infinity. It is also the origin
+    // of the per-pixel expansion (make_splat_geometry), where a far origin cancels catastrophically (a
+    // plaza training run met a 1.2 m-deep surfel whose centre overflowed and made NaN gradients). Far
+    // outside the image the filter cannot reach any pixel anyway, so the crossing-case centre is used.
+    if (out.conic_center) {
+        const T margin = T(2) * T(view.width + view.height);
+        const T cx = out.center.x, cy = out.center.y;
+        const T max_x = T(view.width) + margin, max_y = T(view.height) + margin;
+        const bool near_image = cx > -margin && max_x > cx && cy > -margin && max_y > cy;
+        if (!near_image) {
+            out.conic_center = false;
+            out.center = {out.tu.z / out.tw.z, out.tv.z / out.tw.z};
+        }
+    }
     if (!(std::isfinite(out.center.x) && std::isfinite(out.center.y))) return false;
 
     // Pixels it can reach.
@@ -181,8 +195,10 @@ template <typename T>
 LG_HD inline SurfelGeometryGrad<T> project_surfel_vjp(const SurfelGeometry<T>& g, const PinholeView<T>& view,
                                                       const ProjectedSurfel<T>& p,
                                                       ProjectedSurfelGrad<T> grad) {
-    // 1. Filter centre -> rows of T.
-    if (p.conic_center) {
+    // 1. Filter centre -> rows of T. Near the boundary of the conic branch (d -> 0-) the centre runs off to
+    // infinity and its derivative with it; no pixel then uses the filter, so its gradient is exactly 0, and
+    // skipping the chain keeps 0 * inf from turning into NaN.
+    if (p.conic_center && (grad.center.x != T(0) || grad.center.y != T(0))) {
         const T c2 = T(kSigmaCutoff * kSigmaCutoff);
         const Vec3<T> t{c2, c2, T(-1)};
         const T d = conic_denominator(p.tw, c2);
@@ -195,7 +211,7 @@ LG_HD inline SurfelGeometryGrad<T> project_surfel_vjp(const SurfelGeometry<T>& g
             grad.tw[k] += gx * (tk_d * p.tu[k] - p.center.x * 2 * tk_d * p.tw[k]) +
                           gy * (tk_d * p.tv[k] - p.center.y * 2 * tk_d * p.tw[k]);
         }
-    } else {
+    } else if (!p.conic_center) {
         const T inv_w = T(1) / p.tw.z;
         grad.tu.z += grad.center.x * inv_w;
         grad.tv.z += grad.center.y * inv_w;
