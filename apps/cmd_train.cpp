@@ -82,8 +82,9 @@ void truncate_log(const std::string& path, std::int64_t iteration) {
 
 class Progress {
   public:
-    Progress(std::int64_t total, bool quiet)
-        : total_(total), quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0) {}
+    // `start`: the iteration the run (re)starts from, so that the first rate is not inflated on --resume.
+    Progress(std::int64_t start, std::int64_t total, bool quiet)
+        : total_(total), quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0), last_iteration_(start) {}
 
     void update(const StepReport& r, bool force) {
         psnr_.push_back(r.psnr > 0 ? r.psnr : psnr_.empty() ? 0 : psnr_.back());
@@ -122,7 +123,7 @@ class Progress {
     std::int64_t total_;
     bool quiet_, tty_;
     std::chrono::steady_clock::time_point last_print_ = std::chrono::steady_clock::now();
-    std::int64_t last_iteration_ = 0;
+    std::int64_t last_iteration_;
     std::deque<double> psnr_;
 };
 
@@ -206,7 +207,7 @@ int run_train(const TrainFlags& f) {
     std::signal(SIGINT, on_interrupt);
     std::signal(SIGTERM, on_interrupt);
     std::ofstream log(paths.log, std::ios::app);
-    Progress progress(config.iterations, f.quiet);
+    Progress progress(trainer->iteration(), config.iterations, f.quiet);
     const auto t0 = std::chrono::steady_clock::now();
     auto elapsed = [&] {
         return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
