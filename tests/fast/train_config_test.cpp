@@ -87,6 +87,7 @@ std::vector<MemberChange> every_member() {
         {"lambda_range01", [](TrainConfig& c) { c.lambda_range01 = 1e-300; }},
         {"lambda_env", [](TrainConfig& c) { c.lambda_env = 0.0; }},
         {"lambda_consistency", [](TrainConfig& c) { c.lambda_consistency = 1.0; }},
+        {"consistency_final_ratio", [](TrainConfig& c) { c.consistency_final_ratio = 0.0; }},
         {"lambda_shadow", [](TrainConfig& c) { c.lambda_shadow = 123456789.125; }},
         {"lambda_normal", [](TrainConfig& c) { c.lambda_normal = 2.0 / 7.0; }},
         {"lambda_distortion", [](TrainConfig& c) { c.lambda_distortion = 1e22; }},
@@ -224,7 +225,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 40, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 41, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;

@@ -54,6 +54,7 @@ constexpr std::array kFields = {
     LUMIGAUSS_FIELD(lambda_range01),
     LUMIGAUSS_FIELD(lambda_env),
     LUMIGAUSS_FIELD(lambda_consistency),
+    LUMIGAUSS_FIELD(consistency_final_ratio),
     LUMIGAUSS_FIELD(lambda_shadow),
     LUMIGAUSS_FIELD(lambda_normal),
     LUMIGAUSS_FIELD(lambda_distortion),
@@ -436,12 +437,13 @@ void validate_train_config(const TrainConfig& c) {
     require(c.start_regularization >= 0, "start_regularization", c.start_regularization, "must be >= 0");
 
     // Loss weights, noise, Monte Carlo.
-    const std::array<std::pair<std::string_view, double>, 9> non_negative = {{
+    const std::array<std::pair<std::string_view, double>, 10> non_negative = {{
         {"lambda_dssim", c.lambda_dssim},
         {"lambda_unshadowed_stage3", c.lambda_unshadowed_stage3},
         {"lambda_range01", c.lambda_range01},
         {"lambda_env", c.lambda_env},
         {"lambda_consistency", c.lambda_consistency},
+        {"consistency_final_ratio", c.consistency_final_ratio},
         {"lambda_shadow", c.lambda_shadow},
         {"lambda_normal", c.lambda_normal},
         {"lambda_distortion", c.lambda_distortion},

@@ -32,6 +32,7 @@ struct TrainConfig {
     double lambda_range01 = 0.001;            // l_[0,1]
     double lambda_env = 0.05;                 // l_+
     double lambda_consistency = 10.0;         // l_consistency (10 for NeRF-OSR scenes, run_all.sh)
+    double consistency_final_ratio = 1.0;     // stage-3 l_consistency weight = lambda_consistency x this
     double lambda_shadow = 10.0;              // l_shadow (stage 3)
     double lambda_normal = 0.05;
     double lambda_distortion = 100.0;

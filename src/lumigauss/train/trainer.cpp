@@ -324,7 +324,9 @@ void Trainer::physical_step(std::int64_t it, Stage stage, StepReport& report) {
     const auto t0 = Clock::now();
     TransferLossWeights<double> w;
     w.range01 = c.lambda_range01;
-    w.consistency = c.lambda_consistency;
+    // Official update_lambdas: the stage-3 weight is the stage-2 weight times
+    // consistency_loss_lambda_final_ratio.
+    w.consistency = c.lambda_consistency * (stage == Stage::Shadowed ? c.consistency_final_ratio : 1.0);
     w.shadow = stage == Stage::Shadowed ? c.lambda_shadow : 0.0;
     const TransferLossResult r =
         model_transfer_losses(state_.model, scratch_->normals, c.transfer_samples, c.seed, it, w, true);
