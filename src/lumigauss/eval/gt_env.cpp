@@ -1,6 +1,7 @@
 #include "lumigauss/eval/gt_env.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -326,8 +327,10 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
         ShCoeffs<float> env;
         for (int j = 0; j < kShCount; ++j)
             env.c[j] = (truth.c[j] * (result.light.scale * im->exposure)).cast<float>();
+        const auto t0 = std::chrono::steady_clock::now();
         const RasterImages<float> both =
             render_with_environment(run.model, v->camera, env, ShadingMode::Both);
+        r.render_ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         GtEnvPanels& p = r.panels;
         p.shadowed = clamp01(channel_slice(both.color, w, h, kSurfelColourChannels, kShadowedOffset, 3));
         p.unshadowed = clamp01(channel_slice(both.color, w, h, kSurfelColourChannels, kUnshadowedOffset, 3));
@@ -466,6 +469,12 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
         for (const GtEnvImageResult& r : result.images) missing += r.normal.missing;
         result.pooled_normal = angle_stats(std::move(pooled_angles));
         result.pooled_normal.missing = missing;
+    }
+    std::vector<double> render_ms;
+    for (const GtEnvImageResult& r : result.images) render_ms.push_back(r.render_ms);
+    if (!render_ms.empty()) {
+        std::sort(render_ms.begin(), render_ms.end());
+        result.median_render_ms = render_ms[render_ms.size() / 2];
     }
     if (!options.keep_panels)
         for (GtEnvImageResult& r : result.images) r.panels = GtEnvPanels{};

@@ -131,6 +131,7 @@ struct GtEnvImageResult {
     std::string name, condition;
     double exposure = 1.0;
     std::size_t mask_pixels = 0;
+    double render_ms = 0;  // wall time of the one 6-channel render (shadowed + unshadowed + maps)
     ImageMetrics shadowed, unshadowed;
     bool has_albedo = false, has_normal = false;
     AlbedoMetrics albedo, albedo_gamma;
@@ -146,6 +147,7 @@ struct GtEnvResult {
     std::vector<GtEnvImageResult> images;
     // Means over images (PSNR averaged as PSNR, as officially).
     ImageMetrics mean_shadowed, mean_unshadowed;
+    double median_render_ms = 0;
     std::array<double, 3> albedo_scale{1, 1, 1}, albedo_gamma_scale{1, 1, 1};
     AlbedoMetrics mean_albedo, mean_albedo_gamma;
     AngularErrorStats mean_normal;    // mean of the per-image means and of the per-image medians

@@ -98,6 +98,7 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
         e["condition"] = im.condition;
         e["exposure"] = im.exposure;
         e["mask_pixels"] = im.mask_pixels;
+        e["render_ms"] = im.render_ms;
         e["shadowed"] = metrics_json(im.shadowed);
         e["unshadowed"] = metrics_json(im.unshadowed);
         if (im.has_albedo)
@@ -113,6 +114,7 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
         mean["albedo"] = albedo_json(r.mean_albedo), mean["albedo_gamma"] = albedo_json(r.mean_albedo_gamma);
     if (r.has_normal) mean["normal"] = normal_json(r.mean_normal, false);
     j["mean"] = mean;
+    j["median_render_ms"] = r.median_render_ms;
     if (r.has_normal) j["normal_all_pixels"] = normal_json(r.pooled_normal);
     return j;
 }
