@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "lumigauss/math/hd.h"
 #include "lumigauss/render/cpu/multiversion.h"
 #include "lumigauss/synth/rng.h"
 #include "lumigauss/util/error.h"
@@ -31,7 +32,7 @@ void sample_directions(synth::Rng& rng, int count, Vec3<T>* out) {
 // counter hash per random number (vectorisable, unlike a sequential generator).
 constexpr int kLanes = 16;
 
-inline std::uint32_t hash32(std::uint32_t x) {  // "lowbias32" finaliser (C. Wellons)
+LG_HD_INLINE std::uint32_t hash32(std::uint32_t x) {  // "lowbias32" finaliser (C. Wellons)
     x ^= x >> 16;
     x *= 0x7feb352dU;
     x ^= x >> 15;
@@ -41,7 +42,7 @@ inline std::uint32_t hash32(std::uint32_t x) {  // "lowbias32" finaliser (C. Wel
 }
 
 // Uniform in [-1, 1) from the random number `index` of a surfel's stream.
-inline float uniform_pm1(std::uint32_t key_lo, std::uint32_t key_hi, std::uint32_t index) {
+LG_HD_INLINE float uniform_pm1(std::uint32_t key_lo, std::uint32_t key_hi, std::uint32_t index) {
     const std::uint32_t h = hash32((key_lo + index * 0x9e3779b9U) ^ key_hi);
     return float(h >> 8) * 0x1.0p-23f - 1.0f;
 }
@@ -62,8 +63,10 @@ struct LaneBatch {
     float moment[kMoments][kLanes]{};
 };
 
+// Inlined into each per-instruction-set wrapper below; a plain inline function would be compiled once, for
+// the baseline, and the wrappers would gain nothing.
 template <bool kWithMoments>
-inline void run_samples_impl(LaneBatch& b, int samples) {
+LG_HD_INLINE void run_samples_impl(LaneBatch& b, int samples) {
     for (int s = 0; s < samples; ++s) {
         const auto i0 = std::uint32_t(3 * s);
 #pragma omp simd
