@@ -1,6 +1,8 @@
-// `lumigauss render --ply FILE --scene DIR`: renders a surfel PLY in the 2DGS layout from the cameras of a
-// scene, one PNG per view named after its image, so the rasterizer can be checked from outside and 2DGS
-// models trained elsewhere can be rendered.
+// `lumigauss render`, two modes:
+//   render RUN --light L [--scene DIR] [--cameras ...]: relights a trained run (relight/relight_job.h);
+//   render --ply FILE --scene DIR: renders a surfel PLY in the 2DGS layout from the cameras of a scene, one
+//   PNG per view named after its image, so the rasterizer can be checked from outside and 2DGS models
+//   trained elsewhere can be rendered.
 #include <tbb/global_control.h>
 
 #include <chrono>
@@ -11,6 +13,7 @@
 #include "commands.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
+#include "lumigauss/relight/relight_job.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/scene/splat_ply.h"
 #include "lumigauss/util/error.h"
@@ -20,10 +23,15 @@ namespace {
 
 struct RenderOptions {
     std::string ply, scene, out = "renders", split = "all";
-    int downscale = 1;
+    int downscale = 0;  // 0: 1 for --ply, the run's training resolution for a run
     int threads = 0;
     std::vector<float> background{0, 0, 0};
+    bool background_given = false, split_given = false;
     bool extra_maps = false;
+    // Run mode (relight_job.h).
+    std::string run, outputs = "all";
+    bool no_video = false, quiet = false;
+    RelightJob job;
 };
 
 std::filesystem::path output_path(const std::string& dir, const std::string& image_name,
@@ -56,14 +64,40 @@ void write_extra_maps(const RenderOptions& o, const View& v, const RasterImages<
     write_png(output_path(o.out, v.name, "_normal.png").string(), normal);
 }
 
+void run_relight(const RenderOptions& o) {
+    if (o.extra_maps) throw Error("--maps is for --ply; a run's maps are chosen with --outputs");
+    if (o.split_given) throw Error("--split is for --ply; a run's cameras are chosen with --cameras");
+    RelightJob job = o.job;
+    job.run = o.run;
+    job.scene = o.scene;
+    job.out = o.out;
+    job.downscale = o.downscale;
+    job.outputs = parse_relit_outputs(o.outputs);
+    job.outputs.exr = o.job.outputs.exr;
+    job.outputs.has_background = o.background_given;
+    job.outputs.background = {o.background[0], o.background[1], o.background[2]};
+    job.video = !o.no_video;
+    const auto t0 = std::chrono::steady_clock::now();
+    const RelightSummary summary = run_relight_job(job, [&](const std::string& line) {
+        if (!o.quiet) std::printf("%s\n", line.c_str());
+    });
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("render: wrote %d frame(s) from %zu camera(s) to %s (%.1f s)\n", summary.frames,
+                summary.cameras.size(), o.out.c_str(), s);
+}
+
 void run_render(const RenderOptions& o) {
     std::unique_ptr<tbb::global_control> threads;
     if (o.threads > 0)
         threads =
             std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, o.threads);
     if (o.background.size() != 3) throw Error("--background needs three values R,G,B");
+    if (o.run.empty() == o.ply.empty())
+        throw Error("render: give either a training run folder (render RUN --light L) or --ply FILE");
+    if (!o.run.empty()) return run_relight(o);
+    if (o.scene.empty()) throw Error("render --ply needs --scene (the cameras to render from)");
     DatasetOptions dopt;
-    dopt.downscale = o.downscale;
+    dopt.downscale = o.downscale > 0 ? o.downscale : 1;
     const Dataset scene = load_dataset(o.scene, dopt);
     ViewDependentSurfels model = load_2dgs_ply(o.ply);
     std::printf("render: %zu surfels (SH degree %d) from %s, %zu views of %s\n", model.size(),
@@ -95,24 +129,101 @@ void run_render(const RenderOptions& o) {
 
 void register_render(CLI::App& app) {
     auto o = std::make_shared<RenderOptions>();
-    CLI::App* cmd =
-        app.add_subcommand("render", "Render a surfel PLY (2DGS layout) from the cameras of a scene");
-    cmd->add_option("--ply", o->ply, "surfel model in the 2DGS PLY layout")
-        ->required()
+    CLI::App* cmd = app.add_subcommand(
+        "render",
+        "Relight a trained run (render RUN --light L ...) or render a surfel PLY in the 2DGS layout "
+        "(render --ply FILE --scene DIR)");
+    cmd->add_option("run", o->run, "training run folder (model.ply, lighting.lgmlp, appearance.json)");
+    cmd->add_option("--ply", o->ply, "surfel model in the 2DGS PLY layout (instead of a run)")
         ->check(CLI::ExistingFile);
-    cmd->add_option("--scene", o->scene, "scene folder (COLMAP or NeRF-OSR layout)")->required();
+    cmd->add_option("--scene", o->scene,
+                    "scene folder (COLMAP or NeRF-OSR layout): its cameras; needed for --ply and for "
+                    "--cameras train|test|validation|all|orbit");
     cmd->add_option("-o,--output", o->out, "output folder")->capture_default_str();
-    cmd->add_option("-r,--downscale", o->downscale, "downscale images by 1, 2, 4 or 8")
-        ->check(CLI::IsMember({1, 2, 4, 8}))
-        ->capture_default_str();
-    cmd->add_option("--split", o->split, "which views: all, train, test")
+    cmd->add_option("-r,--downscale", o->downscale,
+                    "downscale images by 1, 2, 4 or 8 (default: 1 for --ply, the run's training "
+                    "resolution for a run; a camera JSON is used as is unless given)")
+        ->check(CLI::IsMember({1, 2, 4, 8}));
+    cmd->add_option("--split", o->split, "--ply: which views: all, train, test, validation")
         ->check(CLI::IsMember({"all", "train", "test", "validation"}))
         ->capture_default_str();
-    cmd->add_option("--background", o->background, "background colour R,G,B in [0,1]")->delimiter(',');
+    cmd->add_option("--background", o->background,
+                    "background colour R,G,B in [0,1] (a run: composited under colour and albedo using "
+                    "alpha; default black)")
+        ->delimiter(',');
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)");
     cmd->add_flag("--maps", o->extra_maps,
-                  "also write alpha (PNG), expected depth (EXR) and world normals (PNG)");
-    cmd->callback([o] { run_render(*o); });
+                  "--ply: also write alpha (PNG), expected depth (EXR) and world normals (PNG)");
+
+    RelightJob& j = o->job;
+    const std::string run_group = "Relighting a run";
+    cmd->add_option("--light", j.light,
+                    "the lighting: a training photo's name (its learned light), a .txt SH file (9 rows R G "
+                    "B, world frame) or an equirectangular panorama (.hdr, .exr, .png, .jpg; top row = up); "
+                    "prefixes photo:, sh:, pano: force the kind")
+        ->group(run_group);
+    cmd->add_option("--cameras", j.cameras,
+                    "train, test, validation, all (the scene's views), orbit (a turntable around the "
+                    "scene's SfM centre at its cameras' mean height and distance, intrinsics of its first "
+                    "view), or a camera JSON file")
+        ->capture_default_str()
+        ->group(run_group);
+    cmd->add_option("--view", j.views, "render only this camera (image name or its stem; repeatable)")
+        ->allow_extra_args(false)
+        ->group(run_group);
+    cmd->add_option("--frames", j.orbit_frames, "cameras of --cameras orbit")
+        ->capture_default_str()
+        ->group(run_group);
+    cmd->add_option("--up", j.up,
+                    "world up axis for --rotate/--spin, panoramas and orbits: +z (synthetic scenes, "
+                    "Blender), -y (COLMAP/NeRF-OSR y-down), +y, +x, -x, -z, or auto (from the cameras)")
+        ->capture_default_str()
+        ->group(run_group);
+    cmd->add_option("--rotate", j.rotate_degrees,
+                    "turn the environment by DEG about the up axis (right-handed: counter-clockwise seen "
+                    "from above)")
+        ->capture_default_str()
+        ->group(run_group);
+    cmd->add_option("--spin", j.spin,
+                    "render N frames per camera turning the environment by k*360/N (after --rotate)")
+        ->group(run_group);
+    cmd->add_option("--exposure", j.exposure, "multiply the light SH by E")
+        ->capture_default_str()
+        ->group(run_group);
+    cmd->add_flag("--match-exposure", j.match_exposure,
+                  "first scale the light to the median brightness (DC luma) of the run's learned lights")
+        ->group(run_group);
+    cmd->add_option("--hdr-threshold", j.hdr_threshold,
+                    "fake HDR for LDR panoramas: channel values above T (of 1) ...")
+        ->capture_default_str()
+        ->group(run_group);
+    cmd->add_option("--hdr-scale", j.hdr_scale,
+                    "... are multiplied by S (1: off; the official NeRF-OSR settings use 10 to 30)")
+        ->capture_default_str()
+        ->group(run_group);
+    cmd->add_option("--outputs", o->outputs,
+                    "all, or a comma list of shadowed, unshadowed, albedo, normal, shadow, irradiance, "
+                    "depth, alpha")
+        ->capture_default_str()
+        ->group(run_group);
+    cmd->add_flag("--exr", j.outputs.exr, "also write unclamped EXRs of the colour, shadow and normal maps")
+        ->group(run_group);
+    cmd->add_flag("--no-video", o->no_video, "no MP4 even if ffmpeg is installed")->group(run_group);
+    cmd->add_option("--fps", j.fps, "frames per second of the MP4s")->capture_default_str()->group(run_group);
+    cmd->add_flag("-q,--quiet", o->quiet, "print only the final line")->group(run_group);
+    cmd->footer(
+        "A run writes per camera (STEM = image name without extension; STEM_spinKKK with --spin; orbit_KKK "
+        "for an orbit): STEM_shadowed.png, STEM_unshadowed.png, STEM_albedo.png, STEM_normal.png (world, "
+        "(n+1)/2), STEM_shadow.png (1 - luma(unshadowed - shadowed intensity), 1 = lit), "
+        "STEM_irradiance.png and STEM_irradiance_unshadowed.png (post-gamma intensity, divided by their max "
+        "if > 1), STEM_irradiance.exr, STEM_depth.exr, STEM_alpha.png; with ffmpeg on the PATH and a spin or "
+        "orbit, STEM_shadowed.mp4 / orbit_shadowed.mp4.");
+    cmd->callback([o, cmd] {
+        RenderOptions opts = *o;
+        opts.background_given = cmd->count("--background") > 0;
+        opts.split_given = cmd->count("--split") > 0;
+        run_render(opts);
+    });
 }
 
 }  // namespace lumigauss::cli

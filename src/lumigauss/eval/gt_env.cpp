@@ -12,12 +12,10 @@
 
 #include "lumigauss/math/quaternion.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
-#include "lumigauss/scene/relightable_ply.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/sh_text.h"
 #include "lumigauss/shading/surfel_shading.h"
-#include "lumigauss/train/lighting_mlp.h"
-#include "lumigauss/train/run_folder.h"
+#include "lumigauss/train/trained_run.h"
 #include "lumigauss/train/view_shading.h"
 #include "lumigauss/util/error.h"
 
@@ -172,28 +170,13 @@ ShCoeffs<double> load_condition_sh(const GtSceneMeta& meta, const std::string& c
 // ---- Run ----------------------------------------------------------------------------------------------
 
 RelightableRun load_relightable_run(const std::string& dir) {
-    const RunPaths paths = run_paths(dir);
-    if (!fs::is_directory(dir)) fail_in_file(dir, "not a folder (expected a training run folder)");
-    for (const std::string* f : {&paths.model, &paths.lighting, &paths.appearance})
-        if (!fs::exists(*f))
-            fail_in_file(*f,
-                         "missing: a finished training run holds model.ply, lighting.lgmlp and "
-                         "appearance.json");
+    TrainedRun trained = load_trained_run(dir);
     RelightableRun run;
     run.dir = dir;
-    run.model = load_relightable_ply(paths.model);
-    const LightingMlp mlp = load_lighting_mlp(paths.lighting);
-    run.image_names = load_appearance(paths.appearance);
-    if (mlp.num_images() != int(run.image_names.size()))
-        fail_in_file(paths.lighting, "has " + std::to_string(mlp.num_images()) + " embeddings but " +
-                                         paths.appearance + " lists " +
-                                         std::to_string(run.image_names.size()) + " photos");
-    for (int i = 0; i < mlp.num_images(); ++i) run.learned_sh.push_back(mlp.env_sh(i).cast<double>());
-    if (fs::exists(paths.config)) {
-        const Json c = parse_json_file(paths.config);
-        if (c.is_object() && c.contains("downscale") && c["downscale"].is_number_integer())
-            run.downscale = c["downscale"].get<int>();
-    }
+    run.model = std::move(trained.model);
+    run.image_names = std::move(trained.image_names);
+    for (int i = 0; i < trained.lighting.num_images(); ++i) run.learned_sh.push_back(trained.learned_sh(i));
+    run.downscale = trained.downscale;
     return run;
 }
 

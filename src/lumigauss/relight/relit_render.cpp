@@ -1,0 +1,145 @@
+#include "lumigauss/relight/relit_render.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/shading/irradiance.h"
+#include "lumigauss/shading/surfel_shading.h"
+
+namespace lumigauss {
+
+static_assert(kRelitChannels <= kMaxChannels, "the CPU rasterizer blends at most kMaxChannels channels");
+
+RelitRenderer::RelitRenderer(const GaussianModel& model) : model_(model) {
+    const std::size_t n = model.size();
+    const auto& raw = model.param(ModelParam::Albedo);
+    albedo_.resize(3 * n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3f a = albedo_activation(Vec3f{raw[3 * i], raw[3 * i + 1], raw[3 * i + 2]});
+        for (int c = 0; c < 3; ++c) albedo_[3 * i + std::size_t(c)] = a[c];
+    }
+    batch_.channels = kRelitChannels;
+    model.activated(batch_);
+}
+
+const RasterImages<float>& RelitRenderer::render(const Camera& camera, const ShCoeffs<float>& env) {
+    const std::size_t n = model_.size();
+    compute_view_normals(model_, camera, normals_);
+    shade_surfels(model_, env, ShadingMode::Both, normals_, shaded_);
+    const std::size_t ch = std::size_t(kRelitChannels);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
+        float pos[kTransferCoeffs], neg[kTransferCoeffs];
+        for (std::size_t i = r.begin(); i < r.end(); ++i) {
+            float* out = &batch_.colors[i * ch];
+            const float* both = &shaded_.colors[i * std::size_t(kSurfelColourChannels)];
+            for (int c = 0; c < 3; ++c) {
+                out[kRelitShadowed + c] = both[kShadowedOffset + c];
+                out[kRelitUnshadowed + c] = both[kUnshadowedOffset + c];
+                out[kRelitAlbedo + c] = albedo_[3 * i + std::size_t(c)];
+            }
+            model_.transfer_channel0(true, i, pos);
+            model_.transfer_channel0(false, i, neg);
+            const float* transfer = select_transfer(normals_.positive_side[i] != 0, pos, neg);
+            const Vec3f s = shadowed_radiance(transfer, env);
+            const Vec3f u = irradiance(env, normals_.normal[i]);
+            for (int c = 0; c < 3; ++c) {
+                out[kRelitIntensityShadowed + c] = light_intensity(s[c]);
+                out[kRelitIntensityUnshadowed + c] = light_intensity(u[c]);
+            }
+        }
+    });
+    rasterize_forward_cpu(camera, batch_, RasterSettings<float>{}, state_, images_);
+    return images_;
+}
+
+Image raster_channels(const RasterImages<float>& raster, int first, int count) {
+    Image out(raster.width, raster.height, count);
+    const std::size_t pixels = std::size_t(raster.width) * std::size_t(raster.height);
+    const std::size_t src = std::size_t(raster.channels);
+    for (std::size_t p = 0; p < pixels; ++p)
+        for (int c = 0; c < count; ++c)
+            out.pixels[p * std::size_t(count) + std::size_t(c)] =
+                raster.color[p * src + std::size_t(first + c)];
+    return out;
+}
+
+Image shadow_image(const Image& unshadowed, const Image& shadowed) {
+    Image out(unshadowed.width, unshadowed.height, 1);
+    for (std::size_t p = 0; p < out.pixels.size(); ++p) {
+        const float* u = &unshadowed.pixels[3 * p];
+        const float* s = &shadowed.pixels[3 * p];
+        const float luma = 0.2126f * (u[0] - s[0]) + 0.7152f * (u[1] - s[1]) + 0.0722f * (u[2] - s[2]);
+        out.pixels[p] = 1.0f - std::clamp(luma, 0.0f, 1000.0f);
+    }
+    return out;
+}
+
+namespace {
+
+Image normals(const RasterImages<float>& raster, bool encode) {
+    Image out(raster.width, raster.height, 3);
+    const std::size_t pixels = out.pixels.size() / 3;
+    for (std::size_t p = 0; p < pixels; ++p) {
+        const Vec3f n{raster.normal[3 * p], raster.normal[3 * p + 1], raster.normal[3 * p + 2]};
+        const float len = length(n);
+        if (!(len > 1e-3f)) continue;
+        for (int c = 0; c < 3; ++c) {
+            const float v = n[c] / len;
+            out.pixels[3 * p + std::size_t(c)] = encode ? 0.5f * (v + 1.0f) : v;
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+Image encode_normals(const RasterImages<float>& raster) {
+    return normals(raster, true);
+}
+
+Image unit_normals(const RasterImages<float>& raster) {
+    return normals(raster, false);
+}
+
+Image expected_depth(const RasterImages<float>& raster) {
+    Image out(raster.width, raster.height, 1);
+    for (std::size_t p = 0; p < out.pixels.size(); ++p) {
+        const float a = raster.alpha[p];
+        out.pixels[p] = a > 1e-6f ? raster.depth[p] / a : 0.0f;
+    }
+    return out;
+}
+
+Image alpha_image(const RasterImages<float>& raster) {
+    Image out(raster.width, raster.height, 1);
+    out.pixels = raster.alpha;
+    return out;
+}
+
+float display_max(const std::vector<const Image*>& images) {
+    float m = 1.0f;
+    for (const Image* im : images)
+        for (float v : im->pixels)
+            if (v > m) m = v;  // NaN never compares greater
+    return m;
+}
+
+Image divided(const Image& image, float divisor) {
+    Image out = image;
+    for (float& v : out.pixels) v /= divisor;
+    return out;
+}
+
+Image over_background(const Image& colour, const Image& alpha, const Vec3f& background) {
+    Image out = colour;
+    for (std::size_t p = 0; p < alpha.pixels.size(); ++p)
+        for (int c = 0; c < 3; ++c)
+            out.pixels[3 * p + std::size_t(c)] += (1.0f - alpha.pixels[p]) * background[c];
+    return out;
+}
+
+}  // namespace lumigauss

@@ -1,0 +1,37 @@
+#pragma once
+// The world's up axis for relighting: turning the environment (--rotate, --spin), placing a panorama (its
+// top row is up) and orbiting the scene all happen about it. Written as a signed coordinate axis: "+z" (the
+// default: the synthetic scenes and Blender), "-y" (COLMAP/NeRF-OSR reconstructions whose cameras have y
+// down), "+y", "x", ...; "auto" picks the signed axis nearest to the mean up vector of the cameras.
+#include <string>
+#include <vector>
+
+#include "lumigauss/io/camera.h"
+#include "lumigauss/math/vec.h"
+#include "lumigauss/shading/sh.h"
+
+namespace lumigauss {
+
+// "x", "+x", "-x", ... "-z" (case-insensitive) -> the unit vector. Throws Error on anything else.
+Vec3d parse_up_axis(const std::string& text);
+
+// The signed coordinate axis closest to the mean world up vector (-(row 1 of R), the camera's -y) of the
+// cameras. Throws Error when there is no camera or the mean vanishes.
+Vec3d estimate_up_axis(const std::vector<Camera>& cameras);
+
+// "+z", "-y", ...: the axis a unit coordinate vector names (for messages).
+std::string up_axis_name(Vec3d up);
+
+// The panorama frame (shading/envmap.h) whose top row looks along `up`: a rotation with third column `up`.
+// +z: identity; -y: rotation about +X by +90 deg (the y-down frame of envmap.h); +y: about +X by -90 deg;
+// +x: about +Y by +90 deg; -x: about +Y by -90 deg; -z: about +X by 180 deg. `up` must be a coordinate axis.
+Mat3d panorama_frame_for_up(Vec3d up);
+
+// The lighting turned by `degrees` about `up`, right-handed (seen from above, counter-clockwise: a sun at
+// azimuth b moves to b + degrees), with the convention of sh_rotation.h. 0 returns the input unchanged.
+ShCoeffs<double> rotate_about_up(const ShCoeffs<double>& sh, Vec3d up, double degrees);
+
+// The angles of an N-frame spin starting at `start_degrees`: start + k * 360 / N, k = 0..N-1.
+std::vector<double> spin_angles(int frames, double start_degrees);
+
+}  // namespace lumigauss

@@ -1,0 +1,57 @@
+#include "lumigauss/train/trained_run.h"
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "lumigauss/scene/relightable_ply.h"
+#include "lumigauss/util/error.h"
+
+namespace lumigauss {
+
+int TrainedRun::find_image(const std::string& name) const {
+    for (std::size_t i = 0; i < image_names.size(); ++i)
+        if (image_names[i] == name) return int(i);
+    return -1;
+}
+
+ShCoeffs<double> TrainedRun::learned_sh(int index) const {
+    if (index < 0 || index >= lighting.num_images())
+        throw Error(paths.lighting + ": no embedding " + std::to_string(index) + " (the run has " +
+                    std::to_string(lighting.num_images()) + ")");
+    return lighting.env_sh(index).cast<double>();
+}
+
+TrainedRun load_trained_run(const std::string& dir) {
+    namespace fs = std::filesystem;
+    TrainedRun run;
+    run.dir = dir;
+    run.paths = run_paths(dir);
+    if (!fs::is_directory(dir)) fail_in_file(dir, "not a folder (expected a training run folder)");
+    for (const std::string* f : {&run.paths.model, &run.paths.lighting, &run.paths.appearance})
+        if (!fs::exists(*f))
+            fail_in_file(*f,
+                         "missing: a finished training run holds model.ply, lighting.lgmlp and "
+                         "appearance.json");
+    run.model = load_relightable_ply(run.paths.model);
+    run.lighting = load_lighting_mlp(run.paths.lighting);
+    run.image_names = load_appearance(run.paths.appearance);
+    if (run.lighting.num_images() != int(run.image_names.size()))
+        fail_in_file(run.paths.lighting, "has " + std::to_string(run.lighting.num_images()) +
+                                             " embeddings but " + run.paths.appearance + " lists " +
+                                             std::to_string(run.image_names.size()) + " photos");
+    if (fs::exists(run.paths.config)) {
+        std::ifstream in(run.paths.config, std::ios::binary);
+        if (!in) fail_in_file(run.paths.config, "cannot open");
+        std::stringstream text;
+        text << in.rdbuf();
+        const nlohmann::json c = nlohmann::json::parse(text.str(), nullptr, false);
+        if (c.is_discarded()) fail_in_file(run.paths.config, "not valid JSON");
+        if (c.is_object() && c.contains("downscale") && c["downscale"].is_number_integer())
+            run.downscale = c["downscale"].get<int>();
+    }
+    return run;
+}
+
+}  // namespace lumigauss

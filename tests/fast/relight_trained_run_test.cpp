@@ -1,0 +1,99 @@
+// load_trained_run (train/trained_run.h), shared by `render RUN` and `eval`: reads what a run folder holds,
+// gives lighting.env_sh(i) per photo, and names the missing or inconsistent file.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+
+#include "lumigauss/scene/relightable_ply.h"
+#include "lumigauss/train/trained_run.h"
+#include "lumigauss/util/error.h"
+#include "relight_test_util.h"
+#include "support/random_surfels.h"
+#include "support/temp_dir.h"
+
+namespace lumigauss {
+namespace {
+
+using lumigauss::testing::TempDir;
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+std::string message_of(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+void write_appearance(const std::string& path, const std::vector<std::string>& names) {
+    std::ofstream f(path);
+    f << "{\"images\": [";
+    for (std::size_t i = 0; i < names.size(); ++i)
+        f << (i ? ", " : "") << "{\"name\": \"" << names[i] << "\", \"index\": " << i << "}";
+    f << "]}\n";
+}
+
+// A run folder with `photos` embeddings and `names` in appearance.json.
+std::string write_run(const TempDir& tmp, int photos, const std::vector<std::string>& names) {
+    const std::string dir = tmp / "run";
+    fs::create_directories(dir);
+    const RunPaths p = run_paths(dir);
+    save_relightable_ply(p.model, relight_test::random_model(testing::test_camera(), 5, 10));
+    save_lighting_mlp(p.lighting, LightingMlp(photos, 11));
+    write_appearance(p.appearance, names);
+    return dir;
+}
+
+TEST(RelightTrainedRun, LoadsModelLightingNamesAndResolution) {
+    TempDir tmp("relight_trained_run");
+    const std::string dir = write_run(tmp, 2, {"x.png", "y.png"});
+    {
+        std::ofstream c(run_paths(dir).config);
+        c << "{\"downscale\": 4, \"preset\": \"fast\"}\n";
+    }
+    const TrainedRun run = load_trained_run(dir);
+    EXPECT_EQ(run.model.size(), 10u);
+    EXPECT_EQ(run.image_names, (std::vector<std::string>{"x.png", "y.png"}));
+    EXPECT_EQ(run.downscale, 4);
+    EXPECT_EQ(run.find_image("y.png"), 1);
+    EXPECT_EQ(run.find_image("z.png"), -1);
+    const LightingMlp mlp(2, 11);
+    for (int i = 0; i < 2; ++i) {
+        const ShCoeffs<double> sh = run.learned_sh(i);
+        const ShCoeffs<float> expected = mlp.env_sh(i);
+        for (int k = 0; k < kShCount; ++k)
+            for (int c = 0; c < 3; ++c) EXPECT_EQ(sh.c[k][c], double(expected.c[k][c]));
+    }
+    EXPECT_THROW(run.learned_sh(2), Error);
+}
+
+TEST(RelightTrainedRun, NamesTheMissingOrInconsistentFile) {
+    TempDir tmp("relight_trained_run_bad");
+    EXPECT_THAT(message_of([&] { load_trained_run(tmp / "nothing"); }), HasSubstr("not a folder"));
+    const std::string dir = write_run(tmp, 2, {"x.png", "y.png", "z.png"});
+    EXPECT_THAT(message_of([&] { load_trained_run(dir); }), HasSubstr("lighting.lgmlp"));
+    write_appearance(run_paths(dir).appearance, {"x.png", "y.png"});
+    {
+        std::ofstream c(run_paths(dir).config);
+        c << "{ not json";
+    }
+    EXPECT_THAT(message_of([&] { load_trained_run(dir); }), HasSubstr("config.json"));
+    fs::remove(run_paths(dir).config);
+    EXPECT_NO_THROW(load_trained_run(dir));
+    for (const char* f : {"model.ply", "lighting.lgmlp", "appearance.json"}) {
+        TempDir t2("relight_trained_run_missing");
+        const std::string d = write_run(t2, 2, {"x.png", "y.png"});
+        fs::remove(d + "/" + f);
+        const std::string msg = message_of([&] { load_trained_run(d); });
+        EXPECT_THAT(msg, HasSubstr(f));
+        EXPECT_THAT(msg, HasSubstr("missing"));
+    }
+}
+
+}  // namespace
+}  // namespace lumigauss
