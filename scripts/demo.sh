@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The main job on a bundled default: installs dependencies, builds, generates the synthetic demo scene
 # (photos under many lightings, COLMAP model, masks, ground truth), renders its ground-truth surfels, and
-# trains a relightable model on it with the `fast` preset (about 3 minutes on 2 cores).
-# Relighting joins this script when it lands (issue #5).
+# trains a relightable model on it with the `fast` preset (about 3 minutes on 2 cores), scores it on the test
+# photos under their true lighting (gt-env), and relights it under another sky, turning the sky around.
 #   scripts/demo.sh [output folder, default: demo]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,14 +11,20 @@ out="${1:-demo}"
 scripts/setup.sh
 bin=build/lumigauss
 
-echo "== 1/4 generating the synthetic scene (demo preset) in $out/scene"
+echo "== 1/6 generating the synthetic scene (demo preset) in $out/scene"
 "$bin" synth --preset demo -o "$out/scene" --force
-echo "== 2/4 what the loader sees"
+echo "== 2/6 what the loader sees"
 "$bin" info "$out/scene"
-echo "== 3/4 rendering the ground-truth surfel model of the scene from every camera"
+echo "== 3/6 rendering the ground-truth surfel model of the scene from every camera"
 "$bin" render --ply "$out/scene/gt/surfels.ply" --scene "$out/scene" -o "$out/renders" --maps
-echo "== 4/4 training a relightable model (fast preset: 1500 unshadowed, 100 transfer, 1400 shadowed iterations)"
+echo "== 4/6 training a relightable model (fast preset: 1500 unshadowed, 100 transfer, 1400 shadowed iterations)"
 "$bin" train "$out/scene" -o "$out/run" --preset fast --force
+echo "== 5/6 evaluating novel views under novel lights (gt-env protocol)"
+"$bin" eval "$out/run" --scene "$out/scene" --protocol gt-env -o "$out/eval"
+echo "== 6/6 relighting the test views under the first sky of the scene, turned in 8 steps"
+sky=$(ls "$out/scene/env/"*_sh.txt | head -n 1)
+"$bin" render "$out/run" --scene "$out/scene" --cameras test --light "$sky" --match-exposure --spin 8 \
+    -o "$out/relit"
 
 echo
 echo "Done. Look at:"
@@ -27,3 +33,5 @@ echo "  $out/scene/gt/            true albedo, normals, masks; env/ holds each l
 echo "  $out/renders/             the rasterizer's renders of gt/surfels.ply (albedo colours), alpha, depth, normals"
 echo "  $out/run/                 the trained model (model.ply, lighting.lgmlp, appearance.json), config, log.jsonl"
 echo "  $out/run/previews/        photo | shadowed | unshadowed render under the learned lighting"
+echo "  $out/eval/                report.md, metrics.json and contact sheets of the test photos"
+echo "  $out/relit/               the test views relit (shadowed, unshadowed, shadow, albedo, normals, ...) per sky turn"
