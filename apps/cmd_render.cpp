@@ -133,7 +133,9 @@ void register_render(CLI::App& app) {
         "render",
         "Relight a trained run (render RUN --light L ...) or render a surfel PLY in the 2DGS layout "
         "(render --ply FILE --scene DIR)");
-    cmd->add_option("run", o->run, "training run folder (model.ply, lighting.lgmlp, appearance.json)");
+    cmd->add_option("run", o->run,
+                    "training run folder (model.ply, lighting.lgmlp, appearance.json), or a bare relightable "
+                    "PLY in the official LumiGauss layout (then --light must be an SH file or a panorama)");
     cmd->add_option("--ply", o->ply, "surfel model in the 2DGS PLY layout (instead of a run)")
         ->check(CLI::ExistingFile);
     cmd->add_option("--scene", o->scene,

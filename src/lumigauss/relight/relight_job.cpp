@@ -134,7 +134,7 @@ RelightSummary run_relight_job(const RelightJob& job, const std::function<void(c
         throw Error("--spin and --cameras orbit both animate; choose one");
 
     // Everything is loaded and checked before the output folder is made.
-    const TrainedRun run = load_trained_run(job.run);
+    const TrainedRun run = load_run_or_ply(job.run);
     RelightCameras cams = relight_cameras(job, run);
     RelightSummary summary;
     summary.up = cams.up;

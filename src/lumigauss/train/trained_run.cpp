@@ -1,5 +1,7 @@
 #include "lumigauss/train/trained_run.h"
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -51,6 +53,32 @@ TrainedRun load_trained_run(const std::string& dir) {
         if (c.is_object() && c.contains("downscale") && c["downscale"].is_number_integer())
             run.downscale = c["downscale"].get<int>();
     }
+    return run;
+}
+
+bool is_bare_ply(const std::string& path) {
+    namespace fs = std::filesystem;
+    std::string ext = fs::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    return ext == ".ply" && fs::is_regular_file(path);
+}
+
+TrainedRun load_run_or_ply(const std::string& path) {
+    namespace fs = std::filesystem;
+    if (fs::is_directory(path)) return load_trained_run(path);
+    if (!fs::exists(path))
+        fail_in_file(path, "not found (expected a training run folder or a relightable .ply)");
+    if (!is_bare_ply(path))
+        fail_in_file(path,
+                     "neither a training run folder nor a .ply file in the LumiGauss relightable layout");
+    TrainedRun run;
+    const fs::path parent = fs::path(path).parent_path();
+    run.dir = parent.empty() ? std::string(".") : parent.string();
+    run.paths = run_paths(run.dir);
+    run.paths.model = path;
+    run.paths.appearance = path + " (bare PLY: no training photos)";
+    run.model = load_relightable_ply(path);
     return run;
 }
 

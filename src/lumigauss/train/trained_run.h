@@ -31,4 +31,14 @@ struct TrainedRun {
 // embeddings and of photos.
 TrainedRun load_trained_run(const std::string& dir);
 
+// True when `path` names a regular file ending in .ply (case-insensitive).
+bool is_bare_ply(const std::string& path);
+
+// A run folder through load_trained_run, or a bare relightable PLY in the official LumiGauss layout
+// (scene/relightable_ply.h: what the Python code's `save_ply` writes, and a run's model.ply) as a run with no
+// photos (dir = the PLY's folder, paths.model = the PLY), so that models trained with the official code can
+// be relit and exported with external lights (SH files, panoramas). Throws Error naming the path when it is
+// neither, or what load_trained_run / load_relightable_ply throw.
+TrainedRun load_run_or_ply(const std::string& path);
+
 }  // namespace lumigauss

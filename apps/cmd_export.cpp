@@ -1,0 +1,136 @@
+// `lumigauss export SOURCE --format F [--light L] -o FILE`: converts a trained run (or a bare relightable
+// PLY in the official LumiGauss layout) into files other tools open (docs/formats.md):
+//   ply-3dgs         standard 3DGS PLY, colours baked under --light (export/ply_3dgs.h)
+//   splat            the 32-byte-per-splat web format, baked under --light (export/splat_format.h)
+//   ply-relightable  the relightable PLY plus FILE.environments.json (export/relightable_bundle.h)
+//   env              folder of per-photo SH text files and EXR previews (export/environment_files.h)
+// Everything is loaded and checked before anything is written.
+#include <tbb/global_control.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "commands.h"
+#include "lumigauss/export/baked_colours.h"
+#include "lumigauss/export/environment_files.h"
+#include "lumigauss/export/ply_3dgs.h"
+#include "lumigauss/export/relightable_bundle.h"
+#include "lumigauss/export/splat_format.h"
+#include "lumigauss/relight/light_source.h"
+#include "lumigauss/relight/up_axis.h"
+#include "lumigauss/train/trained_run.h"
+#include "lumigauss/util/error.h"
+
+namespace lumigauss::cli {
+namespace {
+
+struct ExportOptions {
+    std::string source, ply, format, out, light, up = "+z", shading = "shadowed";
+    double rotate_degrees = 0, exposure = 1.0, hdr_threshold = 0.99, hdr_scale = 1.0;
+    bool match_exposure = false;
+    int width = 512;
+    int threads = 0;
+};
+
+bool baked_format(const std::string& f) {
+    return f == "ply-3dgs" || f == "splat";
+}
+
+void make_parent(const std::string& path) {
+    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
+}
+
+void run_export(const ExportOptions& o) {
+    std::unique_ptr<tbb::global_control> threads;
+    if (o.threads > 0)
+        threads =
+            std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, o.threads);
+    if (o.format != "ply-3dgs" && o.format != "splat" && o.format != "ply-relightable" && o.format != "env")
+        throw Error("--format '" + o.format + "': use ply-3dgs, splat, ply-relightable or env");
+    if (o.source.empty() == o.ply.empty())
+        throw Error("export: give either a training run folder (or relightable .ply) or --ply FILE");
+    const std::string source = o.source.empty() ? o.ply : o.source;
+    if (!o.ply.empty() && !is_bare_ply(o.ply)) fail_in_file(o.ply, "--ply needs an existing .ply file");
+    if (o.out.empty()) throw Error("export: -o FILE is required");
+    const bool baked = baked_format(o.format);
+    if (baked && o.light.empty()) throw Error("--format " + o.format + " bakes colours: give --light");
+    if (!baked && !o.light.empty())
+        throw Error("--light is for the baked formats (ply-3dgs, splat), not " + o.format);
+    const Vec3d up = parse_up_axis(o.up);
+    const BakeShading shading = parse_bake_shading(o.shading);
+
+    const TrainedRun run = load_run_or_ply(source);
+    if (baked) {
+        PanoramaOptions popt;
+        popt.frame = panorama_frame_for_up(up);
+        popt.hdr_threshold = o.hdr_threshold;
+        popt.hdr_scale = o.hdr_scale;
+        const ResolvedLight light = resolve_light(o.light, run, popt);
+        double factor = o.exposure;
+        if (o.match_exposure) factor *= match_exposure_factor(light.sh, run);
+        const ShCoeffs<double> env = rotate_about_up(scaled(light.sh, factor), up, o.rotate_degrees);
+        const std::vector<float> colours = bake_surfel_colours(run.model, env.cast<float>(), shading);
+        make_parent(o.out);
+        if (o.format == "ply-3dgs")
+            write_3dgs_ply(o.out, run.model, colours);
+        else
+            write_splat_file(o.out, splat_records(run.model, colours));
+        std::printf("export: %zu surfels baked (%s, %s '%s') to %s (%s)\n", run.model.size(),
+                    o.shading.c_str(), light_kind_name(light.kind), light.source.c_str(), o.out.c_str(),
+                    o.format.c_str());
+        return;
+    }
+    if (o.format == "ply-relightable") {
+        make_parent(o.out);
+        const std::string sidecar = write_relightable_bundle(o.out, run, up);
+        std::printf("export: %zu surfels to %s, %zu environment(s) to %s\n", run.model.size(), o.out.c_str(),
+                    run.image_names.size(), sidecar.c_str());
+        return;
+    }
+    const auto files = write_environment_files(o.out, learned_environments(run), up, o.width);
+    std::printf("export: %zu environment(s) to %s (%zu files)\n", run.image_names.size(), o.out.c_str(),
+                files.size());
+}
+
+}  // namespace
+
+void register_export(CLI::App& app) {
+    auto o = std::make_shared<ExportOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "export",
+        "Export a trained run (or a relightable .ply of the official LumiGauss code) as a baked 3DGS PLY, a "
+        ".splat, a relightable PLY with its environments, or the environments alone (docs/formats.md)");
+    cmd->add_option("source", o->source,
+                    "training run folder (model.ply, lighting.lgmlp, appearance.json) or a relightable .ply");
+    cmd->add_option("--ply", o->ply,
+                    "a bare relightable PLY (official LumiGauss layout) instead of a run: no learned lights, "
+                    "use --light with an SH .txt or a panorama");
+    cmd->add_option("--format", o->format, "ply-3dgs, splat, ply-relightable or env")->required();
+    cmd->add_option("-o,--output", o->out,
+                    "output file (ply-3dgs, splat, ply-relightable: FILE.ply + FILE.environments.json) or "
+                    "folder (env)")
+        ->required();
+    cmd->add_option("--light", o->light,
+                    "ply-3dgs/splat: the lighting to bake, as for `render --light` (training photo, SH .txt, "
+                    "panorama; prefixes photo:, sh:, pano:)");
+    cmd->add_option("--shading", o->shading,
+                    "baked colour: shadowed (the full model, positive transfer set) or unshadowed (+normal)")
+        ->capture_default_str();
+    cmd->add_option("--up", o->up, "world up axis: +z (default), -y, +y, +x, -x, -z")->capture_default_str();
+    cmd->add_option("--rotate", o->rotate_degrees, "turn the light by DEG about the up axis")
+        ->capture_default_str();
+    cmd->add_option("--exposure", o->exposure, "multiply the light SH by E")->capture_default_str();
+    cmd->add_flag("--match-exposure", o->match_exposure,
+                  "first scale the light to the median brightness of the run's learned lights");
+    cmd->add_option("--hdr-threshold", o->hdr_threshold, "fake HDR for LDR panoramas: values above T ...")
+        ->capture_default_str();
+    cmd->add_option("--hdr-scale", o->hdr_scale, "... are multiplied by S")->capture_default_str();
+    cmd->add_option("--width", o->width, "env: width of the EXR previews (height = width / 2)")
+        ->capture_default_str();
+    cmd->add_option("--threads", o->threads, "worker threads (0: all cores)");
+    cmd->callback([o] { run_export(*o); });
+}
+
+}  // namespace lumigauss::cli

@@ -1,0 +1,153 @@
+// `lumigauss export` end to end on a tiny trained run: every format writes what docs/formats.md says, the
+// official-layout model.ply with an SH text file bakes exactly as the run with that photo's learned light
+// (import), and bad input fails naming the format or the file.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "lumigauss/export/relightable_bundle.h"
+#include "lumigauss/scene/relightable_ply.h"
+#include "lumigauss/scene/splat_ply.h"
+#include "lumigauss/train/run_folder.h"
+#include "synth_test_util.h"
+
+namespace lumigauss {
+namespace {
+
+using synth_test::TempDir;
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+struct CommandResult {
+    int exit_code = -1;
+    std::string output;
+};
+
+std::string shell_arg(const std::string& s) {
+    return "'" + s + "'";
+}
+
+CommandResult run_lumigauss(const std::string& args, const TempDir& tmp) {
+    const std::string out = tmp.sub("output.txt");
+    const std::string command = std::string("'") + LUMIGAUSS_BINARY + "' " + args + " > '" + out + "' 2>&1";
+    const int status = std::system(command.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, synth_test::read_bytes(out)};
+}
+
+// A tiny scene and a 30-iteration run on it, made once per test process.
+struct TinyRun {
+    TempDir dir{"cli_export_run"};
+    std::string run = dir / "run";
+    std::string setup_output;
+    bool ok = false;
+    TinyRun() {
+        const std::string scene = dir / "scene";
+        CommandResult r = run_lumigauss("synth --preset tiny -o " + shell_arg(scene), dir);
+        setup_output = r.output;
+        if (r.exit_code != 0) return;
+        r = run_lumigauss(
+            "train " + shell_arg(scene) + " -o " + shell_arg(run) + " --preset fast --iterations 30 -q", dir);
+        setup_output += r.output;
+        ok = r.exit_code == 0;
+    }
+};
+
+const TinyRun& tiny_run() {
+    static TinyRun r;
+    return r;
+}
+
+TEST(CliExport, EveryFormatAndImportFromBarePly) {
+    const TinyRun& t = tiny_run();
+    ASSERT_TRUE(t.ok) << t.setup_output;
+    TempDir tmp("cli_export_formats");
+    const std::vector<std::string> photos = load_appearance(run_paths(t.run).appearance);
+    ASSERT_FALSE(photos.empty());
+    const std::size_t surfels = load_relightable_ply(run_paths(t.run).model).size();
+
+    // env: one SH file and one EXR per photo.
+    CommandResult r = run_lumigauss(
+        "export " + shell_arg(t.run) + " --format env --width 64 -o " + shell_arg(tmp / "env"), tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::size_t txt = 0, exr = 0;
+    for (const auto& e : fs::directory_iterator(tmp / "env")) {
+        txt += e.path().extension() == ".txt";
+        exr += e.path().extension() == ".exr";
+    }
+    EXPECT_EQ(txt, photos.size());
+    EXPECT_EQ(exr, photos.size());
+
+    // ply-3dgs under the first photo's learned light; readable by the 2DGS reader.
+    r = run_lumigauss("export " + shell_arg(t.run) + " --format ply-3dgs --light " + shell_arg(photos[0]) +
+                          " -o " + shell_arg(tmp / "baked/photo.ply"),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(load_2dgs_ply(tmp / "baked/photo.ply").size(), surfels);
+
+    // Import: the bare model.ply (official layout) with that photo's SH text file bakes the same bytes.
+    fs::path stem = fs::path(photos[0]).replace_extension();
+    std::string sh_name = stem.string();
+    for (char& c : sh_name)
+        if (c == '/' || c == '\\') c = '_';
+    const std::string sh = tmp / ("env/" + sh_name + "_sh.txt");
+    ASSERT_TRUE(fs::exists(sh)) << sh;
+    r = run_lumigauss("export --ply " + shell_arg(run_paths(t.run).model) + " --format ply-3dgs --light " +
+                          shell_arg(sh) + " -o " + shell_arg(tmp / "baked/imported.ply"),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(synth_test::read_bytes(tmp / "baked/photo.ply"),
+              synth_test::read_bytes(tmp / "baked/imported.ply"));
+
+    // splat: 32 bytes per surfel.
+    r = run_lumigauss("export " + shell_arg(t.run) + " --format splat --light " + shell_arg(sh) + " -o " +
+                          shell_arg(tmp / "m.splat"),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(fs::file_size(tmp / "m.splat"), 32 * surfels);
+
+    // ply-relightable + sidecar.
+    r = run_lumigauss(
+        "export " + shell_arg(t.run) + " --format ply-relightable -o " + shell_arg(tmp / "rel.ply"), tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(load_relightable_ply(tmp / "rel.ply").size(), surfels);
+    EXPECT_EQ(read_environment_sidecar(tmp / "rel.environments.json").environments.size(), photos.size());
+}
+
+TEST(CliExport, BadInputNamesTheProblem) {
+    const TinyRun& t = tiny_run();
+    ASSERT_TRUE(t.ok) << t.setup_output;
+    TempDir tmp("cli_export_bad");
+    CommandResult r =
+        run_lumigauss("export " + shell_arg(t.run) + " --format obj -o " + shell_arg(tmp / "x"), tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("--format 'obj'"));
+
+    const std::string missing = tmp / "no_such_run";
+    r = run_lumigauss("export " + shell_arg(missing) + " --format env -o " + shell_arg(tmp / "e"), tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr(missing));
+
+    r = run_lumigauss("export " + shell_arg(t.run) + " --format splat -o " + shell_arg(tmp / "m.splat"), tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("--light"));
+
+    r = run_lumigauss("export " + shell_arg(t.run) + " --format ply-3dgs --light " +
+                          shell_arg(tmp / "nope.txt") + " -o " + shell_arg(tmp / "m.ply"),
+                      tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("nope.txt"));
+    EXPECT_FALSE(fs::exists(tmp / "m.ply"));
+
+    // A bare PLY has no photos to export.
+    r = run_lumigauss(
+        "export " + shell_arg(run_paths(t.run).model) + " --format env -o " + shell_arg(tmp / "e2"), tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("no learned environments"));
+}
+
+}  // namespace
+}  // namespace lumigauss
