@@ -19,7 +19,7 @@ namespace lumigauss::cli {
 namespace {
 
 struct EvalOptions {
-    std::string run, scene, protocol = "gt-env", out = "eval";
+    std::string run, scene, protocol = "gt-env", out = "eval", views = "test";
     int downscale = 0;  // 0: the run's config.json downscale (1 if unknown)
     int threads = 0;
     bool no_sheets = false, quiet = false;
@@ -38,10 +38,12 @@ void run_eval(const EvalOptions& o) {
     dopt.downscale = o.downscale > 0 ? o.downscale : (run.downscale > 0 ? run.downscale : 1);
     const Dataset scene = load_dataset(o.scene, dopt);
     if (!o.quiet)
-        std::printf("eval: %zu surfels, %zu training photos from %s; %zu test views of %s at 1/%d\n",
-                    run.model.size(), run.image_names.size(), o.run.c_str(), scene.split(Split::Test).size(),
+        std::printf("eval: %zu surfels, %zu training photos from %s; %zu %s views of %s at 1/%d\n",
+                    run.model.size(), run.image_names.size(), o.run.c_str(),
+                    scene.split(o.views == "train" ? Split::Train : Split::Test).size(), o.views.c_str(),
                     o.scene.c_str(), dopt.downscale);
     GtEnvOptions gopt;
+    gopt.views = o.views == "train" ? Split::Train : Split::Test;
     gopt.keep_panels = !o.no_sheets;
     const GtEnvResult result = evaluate_gt_env(run, scene, meta, gopt);
     write_gt_env_report(o.out, result, {o.run, o.scene}, !o.no_sheets);
@@ -93,6 +95,11 @@ void register_eval(CLI::App& app) {
     cmd->add_option("-r,--downscale", o->downscale,
                     "evaluate at 1/1, 1/2, 1/4 or 1/8 resolution (default: the run's training resolution)")
         ->check(CLI::IsMember({0, 1, 2, 4, 8}));
+    cmd->add_option("--views", o->views,
+                    "test: the protocol (novel views, novel lights); train: diagnostic, the training views "
+                    "under their own true lights (separates lighting from novel-view geometry)")
+        ->check(CLI::IsMember({"test", "train"}))
+        ->capture_default_str();
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)");
     cmd->add_flag("--no-sheets", o->no_sheets, "skip the contact sheets");
     cmd->add_flag("-q,--quiet", o->quiet, "print only the final line");

@@ -112,6 +112,25 @@ TEST(CliEval, WritesMetricsReportAndContactSheets) {
     EXPECT_THAT(md, HasSubstr("sheets/" + fs::path(tests[0]->name).stem().string() + ".png"));
 }
 
+// The diagnostic on training views scores every training photo, and says so in metrics.json.
+TEST(CliEval, TrainViewsDiagnostic) {
+    const TinyRun& t = tiny_run();
+    ASSERT_EQ(t.train_exit, 0) << t.train_output;
+    TempDir tmp("cli_eval_train_views");
+    const std::string report = tmp / "report";
+    const CommandResult r =
+        run_lumigauss("eval " + shell_quoted(t.run) + " --scene " + shell_quoted(t.scene) +
+                          " --views train --no-sheets -o " + shell_quoted(report),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const nlohmann::json j = synth_test::read_json(report + "/metrics.json");
+    EXPECT_EQ(j["views"], "train");
+    const nlohmann::json appearance = synth_test::read_json(t.run + "/appearance.json");
+    EXPECT_EQ(j["images"].size(), appearance["images"].size());
+    // The light scale is fitted on the same (training) photos here.
+    EXPECT_EQ(j["light_scale"]["train_photos"], appearance["images"].size());
+}
+
 TEST(CliEval, MissingModelIsNamed) {
     const TinyRun& t = tiny_run();
     ASSERT_EQ(t.train_exit, 0) << t.train_output;

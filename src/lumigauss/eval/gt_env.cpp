@@ -276,10 +276,13 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
                             const GtEnvOptions& options) {
     GtEnvResult result;
     result.downscale = scene.downscale;
-    const std::vector<const View*> views = scene.split(Split::Test);
-    if (views.empty()) throw Error(scene.root + ": the scene has no test image");
-    std::vector<std::string> test_names;
-    for (const View* v : views) test_names.push_back(v->name);
+    result.views = options.views;
+    const std::vector<const View*> views = scene.split(options.views);
+    if (views.empty())
+        throw Error(scene.root + ": the scene has no " + split_name(options.views) + " image to evaluate");
+    std::vector<std::string> test_names;  // excluded from the light-scale fit
+    if (options.views != Split::Train)
+        for (const View* v : views) test_names.push_back(v->name);
     result.light = fit_run_light_scale(run, meta, test_names);
 
     // The albedo batch is the same for every view.

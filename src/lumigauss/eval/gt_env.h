@@ -140,6 +140,7 @@ struct GtEnvImageResult {
 };
 
 struct GtEnvResult {
+    Split views = Split::Test;  // which photos were scored (GtEnvOptions::views)
     LightScaleFit light;
     int downscale = 1;
     bool gt_mask = false;                         // every test image had a gt/mask
@@ -157,6 +158,10 @@ struct GtEnvResult {
 struct GtEnvOptions {
     SsimOptions ssim;  // win 5, as the official evaluation
     bool keep_panels = true;
+    // Which photos are scored. Test (the protocol): novel views under novel lights. Train is a diagnostic
+    // that separates the lighting model from novel-view geometry: the training views, each rendered under its
+    // own TRUE environment (not the learned one); the light scale is then fitted on all training photos.
+    Split views = Split::Test;
 };
 
 // Runs the protocol on every test view of `scene` (loaded at the resolution to evaluate). Throws Error

@@ -75,6 +75,9 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
     j["run"] = src.run;
     j["scene"] = src.scene;
     j["downscale"] = r.downscale;
+    j["views"] = split_name(r.views);
+    if (r.views == Split::Train)
+        j["views_note"] = "diagnostic: training views under their own true lights (not the protocol)";
     Json per_photo = Json::object();
     for (std::size_t i = 0; i < r.light.per_photo.size() && i < r.light.names.size(); ++i)
         per_photo[r.light.names[i]] = number(r.light.per_photo[i]);
@@ -125,6 +128,10 @@ std::string gt_env_report_markdown(const GtEnvResult& r, const ReportSources& sr
     s += "- resolution: downscale " + std::to_string(r.downscale) + ", " + std::to_string(r.images.size()) +
          " test images\n\n";
     s += "## Protocol\n\n";
+    if (r.views == Split::Train)
+        s += "- **Diagnostic run on the TRAINING views** (`--views train`), each under its own true light; "
+             "the "
+             "light scale is fitted on the same photos. The protocol proper scores the test views.\n";
     s += "- Each test photo is rendered under `k * exposure * (true SH of its condition)`: no rotation "
          "search, "
          "no per-image colour fit.\n";
