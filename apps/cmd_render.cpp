@@ -15,6 +15,7 @@
 #include "lumigauss/io/image.h"
 #include "lumigauss/relight/relight_job.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/render/raster_maps.h"
 #include "lumigauss/scene/splat_ply.h"
 #include "lumigauss/util/error.h"
 
@@ -42,26 +43,10 @@ std::filesystem::path output_path(const std::string& dir, const std::string& ima
     return p;
 }
 
-Image color_image(const RasterImages<float>& img) {
-    Image out(img.width, img.height, 3);
-    for (std::size_t i = 0; i < out.pixels.size(); ++i) out.pixels[i] = img.color[i];
-    return out;
-}
-
 void write_extra_maps(const RenderOptions& o, const View& v, const RasterImages<float>& img) {
-    Image alpha(img.width, img.height, 1), depth(img.width, img.height, 1), normal(img.width, img.height, 3);
-    for (std::size_t p = 0; p < img.alpha.size(); ++p) {
-        const float a = img.alpha[p];
-        alpha.pixels[p] = a;
-        depth.pixels[p] = a > 1e-6f ? img.depth[p] / a : 0.0f;
-        Vec3f n{img.normal[3 * p], img.normal[3 * p + 1], img.normal[3 * p + 2]};
-        const float len = length(n);
-        if (len > 0) n = n / len;
-        for (int k = 0; k < 3; ++k) normal.pixels[3 * p + k] = len > 0 ? 0.5f * (n[k] + 1) : 0.5f;
-    }
-    write_png(output_path(o.out, v.name, "_alpha.png").string(), alpha);
-    write_exr(output_path(o.out, v.name, "_depth.exr").string(), depth);
-    write_png(output_path(o.out, v.name, "_normal.png").string(), normal);
+    write_png(output_path(o.out, v.name, "_alpha.png").string(), alpha_image(img));
+    write_exr(output_path(o.out, v.name, "_depth.exr").string(), expected_depth(img));
+    write_png(output_path(o.out, v.name, "_normal.png").string(), encode_normals(img));
 }
 
 void run_relight(const RenderOptions& o) {
@@ -114,7 +99,7 @@ void run_render(const RenderOptions& o) {
         rasterize_forward_cpu(v.camera, model.surfels, settings, state, img);
         const auto path = output_path(o.out, v.name, ".png");
         std::filesystem::create_directories(path.parent_path());
-        write_png(path.string(), color_image(img));
+        write_png(path.string(), raster_channels(img, 0, 3));
         if (o.extra_maps) write_extra_maps(o, v, img);
         const double ms =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -14,12 +14,13 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <sstream>
 
 #include "commands.h"
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
+#include "lumigauss/io/text_file.h"
+#include "lumigauss/render/raster_maps.h"
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/train/checkpoint.h"
 #include "lumigauss/train/run_folder.h"
@@ -48,17 +49,9 @@ double peak_memory_mib() {
     return double(u.ru_maxrss) / 1024.0;  // Linux: kilobytes
 }
 
-std::string read_text(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) fail_in_file(path, "cannot open");
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
 TrainConfig config_from_flags(const TrainFlags& f) {
     TrainConfig c = train_preset(f.preset);
-    if (!f.config_file.empty()) apply_train_config_json(c, read_text(f.config_file), f.config_file);
+    if (!f.config_file.empty()) apply_train_config_json(c, read_text_file(f.config_file), f.config_file);
     for (const auto& o : f.overrides) apply_train_config_override(c, o);
     if (f.iterations > 0) c.iterations = f.iterations;
     if (f.downscale > 0) c.downscale = f.downscale;
@@ -136,18 +129,16 @@ void write_previews(const std::string& dir, const Trainer& trainer, int count) {
         const TrainView& view = views[std::size_t(v)];
         const RasterImages<float> img = render_with_environment(
             trainer.state().model, view.camera, trainer.state().lighting.env_sh(v), ShadingMode::Both);
+        const Image shadowed = raster_channels(img, kShadowedOffset, 3);
+        const Image unshadowed = raster_channels(img, kUnshadowedOffset, 3);
+        const Image* panels[3] = {&view.rgb, &shadowed, &unshadowed};
         const int w = view.rgb.width, h = view.rgb.height;
         Image out(3 * w, h, 3);
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x)
-                for (int c = 0; c < 3; ++c) {
-                    const std::size_t p = std::size_t(y) * std::size_t(w) + std::size_t(x);
-                    out.at(x, y, c) = view.rgb.at(x, y, c);
-                    out.at(w + x, y, c) =
-                        std::clamp(img.color[6 * p + std::size_t(kShadowedOffset + c)], 0.0f, 1.0f);
-                    out.at(2 * w + x, y, c) =
-                        std::clamp(img.color[6 * p + std::size_t(kUnshadowedOffset + c)], 0.0f, 1.0f);
-                }
+        for (int k = 0; k < 3; ++k)
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x)
+                    for (int c = 0; c < 3; ++c)
+                        out.at(k * w + x, y, c) = std::clamp(panels[k]->at(x, y, c), 0.0f, 1.0f);
         std::filesystem::path name = std::filesystem::path(dir) / view.name;
         name.replace_extension(".png");
         std::filesystem::create_directories(name.parent_path());

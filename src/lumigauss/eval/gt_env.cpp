@@ -4,19 +4,18 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <numbers>
-#include <sstream>
 
+#include "lumigauss/io/text_file.h"
 #include "lumigauss/math/quaternion.h"
-#include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/relight/relit_render.h"
+#include "lumigauss/render/raster_maps.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/sh_text.h"
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/train/trained_run.h"
-#include "lumigauss/train/view_shading.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {
@@ -26,14 +25,6 @@ namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
 constexpr double kGamma = 1.0 / surfel_const::kInvGamma;  // 2.2, the model's light-to-colour exponent
-
-std::string read_text_file(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) fail_in_file(path, "cannot open");
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
 
 Json parse_json_file(const std::string& path) {
     Json j = Json::parse(read_text_file(path), nullptr, false);
@@ -55,17 +46,6 @@ Image load_gt_image(const std::string& path, int width, int height, int channels
     return im;
 }
 
-Image channel_slice(const std::vector<float>& src, int width, int height, int src_channels, int first,
-                    int count) {
-    Image out(width, height, count);
-    const std::size_t n = std::size_t(width) * std::size_t(height);
-    for (std::size_t p = 0; p < n; ++p)
-        for (int c = 0; c < count; ++c)
-            out.pixels[p * std::size_t(count) + std::size_t(c)] =
-                src[p * std::size_t(src_channels) + std::size_t(first + c)];
-    return out;
-}
-
 Image multiply_masks(const Image& a, const Image& b) {
     Image out = a;
     for (std::size_t p = 0; p < out.pixels.size(); ++p) out.pixels[p] *= b.pixels[p];
@@ -83,11 +63,6 @@ double to_linear(double v) {
 }
 double to_gamma(double v) {
     return std::pow(std::max(v, 0.0), 1.0 / kGamma);
-}
-
-double luminance(const Image& im, std::size_t p) {
-    const float* c = &im.pixels[p * 3];
-    return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
 }
 
 AlbedoMetrics albedo_metrics(const Image& predicted, const Image& truth, const Image& mask) {
@@ -285,16 +260,8 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
         for (const View* v : views) test_names.push_back(v->name);
     result.light = fit_run_light_scale(run, meta, test_names);
 
-    // The albedo batch is the same for every view.
-    SurfelBatch<float> albedo_batch;
-    albedo_batch.channels = 3;
-    run.model.activated(albedo_batch);
-    const auto& raw_albedo = run.model.param(ModelParam::Albedo);
-    for (std::size_t i = 0; i < run.model.size(); ++i) {
-        const Vec3f a =
-            albedo_activation(Vec3f{raw_albedo[3 * i], raw_albedo[3 * i + 1], raw_albedo[3 * i + 2]});
-        for (int c = 0; c < 3; ++c) albedo_batch.colors[3 * i + std::size_t(c)] = a[c];
-    }
+    // One pass per view gives both colours, both intensities and the albedo (relight/relit_render.h).
+    RelitRenderer renderer(run.model);
 
     std::vector<AlbedoInputs> albedo_inputs;
     std::vector<double> pooled_angles;
@@ -314,12 +281,11 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
         for (int j = 0; j < kShCount; ++j)
             env.c[j] = (truth.c[j] * (result.light.scale * im->exposure)).cast<float>();
         const auto t0 = std::chrono::steady_clock::now();
-        const RasterImages<float> both =
-            render_with_environment(run.model, v->camera, env, ShadingMode::Both);
+        const RasterImages<float>& relit = renderer.render(v->camera, env);
         r.render_ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         GtEnvPanels& p = r.panels;
-        p.shadowed = clamp01(channel_slice(both.color, w, h, kSurfelColourChannels, kShadowedOffset, 3));
-        p.unshadowed = clamp01(channel_slice(both.color, w, h, kSurfelColourChannels, kUnshadowedOffset, 3));
+        p.shadowed = clamp01(raster_channels(relit, kRelitShadowed, 3));
+        p.unshadowed = clamp01(raster_channels(relit, kRelitUnshadowed, 3));
         p.truth = scene.load_image(*v);
 
         // Evaluation mask.
@@ -337,28 +303,13 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
         r.shadowed = image_metrics(p.shadowed, p.truth, p.mask, options.ssim);
         r.unshadowed = image_metrics(p.unshadowed, p.truth, p.mask, options.ssim);
 
-        // Shadow panel: luminance ratio shadowed / unshadowed where something is rendered.
-        p.shadow = Image(w, h, 1);
-        for (std::size_t q = 0; q < p.shadow.pixels.size(); ++q) {
-            const double u = luminance(p.unshadowed, q);
-            p.shadow.pixels[q] =
-                both.alpha[q] > 0.5f && u > 1e-4 ? float(std::min(1.0, luminance(p.shadowed, q) / u)) : 0.f;
-        }
-
-        // Albedo and normal maps of the model.
-        RasterState<float> state;
-        const RasterImages<float> albedo = rasterize_forward_cpu(v->camera, albedo_batch, {}, state);
-        Image rendered_albedo(w, h, 3);
-        rendered_albedo.pixels = albedo.color;
+        // The paper's shadow image (as `render` writes it) and the model's albedo and normal maps.
+        p.shadow = shadow_image(raster_channels(relit, kRelitIntensityUnshadowed, 3),
+                                raster_channels(relit, kRelitIntensityShadowed, 3));
+        const Image rendered_albedo = raster_channels(relit, kRelitAlbedo, 3);
         Image rendered_normal(w, h, 3);
-        rendered_normal.pixels = albedo.normal;
-        p.normal = Image(w, h, 3);
-        for (std::size_t q = 0; q < std::size_t(w) * std::size_t(h); ++q) {
-            const Vec3d n{albedo.normal[3 * q], albedo.normal[3 * q + 1], albedo.normal[3 * q + 2]};
-            const double len = length(n);
-            for (int c = 0; c < 3; ++c)
-                p.normal.pixels[3 * q + std::size_t(c)] = len > 1e-3 ? float(0.5 * (n[c] / len + 1)) : 0.f;
-        }
+        rendered_normal.pixels = relit.normal;
+        p.normal = encode_normals(relit);
 
         const std::string gt_albedo_path = gt_path(meta.root, "albedo", v->name);
         if (fs::exists(gt_albedo_path)) {

@@ -3,11 +3,10 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "lumigauss/io/atomic_file.h"
+#include "lumigauss/io/text_file.h"
 #include "lumigauss/relight/up_axis.h"
 #include "lumigauss/scene/relightable_ply.h"
 #include "lumigauss/util/error.h"
@@ -56,11 +55,7 @@ std::string write_relightable_bundle(const std::string& ply_path, const TrainedR
 }
 
 EnvironmentSidecar read_environment_sidecar(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) fail_in_file(path, "cannot open");
-    std::stringstream text;
-    text << in.rdbuf();
-    const nlohmann::json j = nlohmann::json::parse(text.str(), nullptr, false);
+    const nlohmann::json j = nlohmann::json::parse(read_text_file(path), nullptr, false);
     if (j.is_discarded() || !j.is_object()) fail_in_file(path, "not a JSON object");
     if (j.value("format", std::string()) != "lumigauss-environments")
         fail_in_file(path, "\"format\" is not \"lumigauss-environments\"");

@@ -3,12 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <sstream>
 
 #include "lumigauss/io/atomic_file.h"
+#include "lumigauss/io/text_file.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {
@@ -85,11 +84,7 @@ bool safe_name(const std::string& name) {
 }  // namespace
 
 std::vector<NamedCamera> read_camera_json(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) fail_in_file(path, "cannot open (the camera path file)");
-    std::stringstream text;
-    text << in.rdbuf();
-    const Json doc = Json::parse(text.str(), nullptr, false);
+    const Json doc = Json::parse(read_text_file(path), nullptr, false);
     if (doc.is_discarded()) fail_in_file(path, "not valid JSON");
     const Json* list = &doc;
     if (doc.is_object() && doc.contains("cameras")) list = &doc["cameras"];

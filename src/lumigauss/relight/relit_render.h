@@ -1,15 +1,19 @@
 #pragma once
 // One rasterisation of a relightable model under one environment, carrying every per-surfel quantity the
-// relighting tool writes (15 colour channels, research/lumigauss_official.md 3 and 7):
-//   0..2   shadowed colour     albedo * max(T . L, 1e-5)^(1/2.2)   (as render_with_environment,
-//   ShadingMode::Both) 3..5   unshadowed colour   albedo * max(E(n), 1e-5)^(1/2.2) 6..8   shadowed intensity
-//   max(T . L, 1e-5)^(1/2.2)           (official "intensity", post-gamma) 9..11  unshadowed intensity
-//   max(E(n), 1e-5)^(1/2.2) 12..14 albedo              max(0, Y00 a + 0.5)
+// relighting tool writes (research/lumigauss_official.md 3 and 7), in 15 colour channels:
+//
+//     0..2    shadowed colour        albedo * max(T . L, 1e-5)^(1/2.2)  (as render_with_environment, Both)
+//     3..5    unshadowed colour      albedo * max(E(n), 1e-5)^(1/2.2)
+//     6..8    shadowed intensity     max(T . L, 1e-5)^(1/2.2)  (the official post-gamma "intensity")
+//     9..11   unshadowed intensity   max(E(n), 1e-5)^(1/2.2)
+//     12..14  albedo                 max(0, Y00 a + 0.5)
+//
 // plus the rasterizer's alpha, depth and world-normal maps. Black background, as in training.
 #include <vector>
 
 #include "lumigauss/io/camera.h"
 #include "lumigauss/io/image.h"
+#include "lumigauss/render/raster_maps.h"
 #include "lumigauss/render/raster_types.h"
 #include "lumigauss/scene/gaussian_model.h"
 #include "lumigauss/shading/sh.h"
@@ -38,22 +42,10 @@ class RelitRenderer {
     RasterImages<float> images_;
 };
 
-// Channels [first, first + count) of an interleaved raster colour buffer, as an Image.
-Image raster_channels(const RasterImages<float>& raster, int first, int count);
-
 // The official shadow image (render_rotate_envmap.py): 1 - clamp(luma(I_unshadowed - I_shadowed), 0, 1000)
 // on the rasterised post-gamma intensities, Rec. 709 luma weights. 1 = unshadowed (also the background),
 // lower = more shadow; negative values where the difference exceeds 1 (a PNG clamps them to 0).
 Image shadow_image(const Image& intensity_unshadowed, const Image& intensity_shadowed);
-
-// World normals encoded (n / |n| + 1) / 2; 0 where |n| <= 1e-3 (nothing rendered).
-Image encode_normals(const RasterImages<float>& raster);
-// World normals n / |n| in [-1, 1]; 0 where |n| <= 1e-3.
-Image unit_normals(const RasterImages<float>& raster);
-
-// Expected depth depth / alpha where alpha > 1e-6, else 0 (1 channel).
-Image expected_depth(const RasterImages<float>& raster);
-Image alpha_image(const RasterImages<float>& raster);
 
 // The largest value of any of the images, at least 1: the official irradiance visualisation divides by
 // the maximum when it exceeds 1.

@@ -1,11 +1,10 @@
 #include "lumigauss/train/run_folder.h"
 
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "lumigauss/io/atomic_file.h"
+#include "lumigauss/io/text_file.h"
 #include "lumigauss/scene/relightable_ply.h"
 #include "lumigauss/util/error.h"
 
@@ -32,11 +31,7 @@ void save_run_model(const RunPaths& paths, const TrainState& state) {
 }
 
 std::vector<std::string> load_appearance(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) fail_in_file(path, "cannot open");
-    std::stringstream text;
-    text << in.rdbuf();
-    const nlohmann::json j = nlohmann::json::parse(text.str(), nullptr, false);
+    const nlohmann::json j = nlohmann::json::parse(read_text_file(path), nullptr, false);
     if (j.is_discarded() || !j.is_object() || !j.contains("images") || !j["images"].is_array())
         fail_in_file(path, "expected a JSON object with an \"images\" array");
     std::vector<std::string> names(j["images"].size());

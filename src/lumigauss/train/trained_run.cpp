@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
+#include "lumigauss/io/text_file.h"
 #include "lumigauss/scene/relightable_ply.h"
 #include "lumigauss/util/error.h"
 
@@ -44,11 +43,7 @@ TrainedRun load_trained_run(const std::string& dir) {
                                              " embeddings but " + run.paths.appearance + " lists " +
                                              std::to_string(run.image_names.size()) + " photos");
     if (fs::exists(run.paths.config)) {
-        std::ifstream in(run.paths.config, std::ios::binary);
-        if (!in) fail_in_file(run.paths.config, "cannot open");
-        std::stringstream text;
-        text << in.rdbuf();
-        const nlohmann::json c = nlohmann::json::parse(text.str(), nullptr, false);
+        const nlohmann::json c = nlohmann::json::parse(read_text_file(run.paths.config), nullptr, false);
         if (c.is_discarded()) fail_in_file(run.paths.config, "not valid JSON");
         if (c.is_object() && c.contains("downscale") && c["downscale"].is_number_integer())
             run.downscale = c["downscale"].get<int>();
