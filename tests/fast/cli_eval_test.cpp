@@ -3,7 +3,6 @@
 // meta.json fail with a message naming the file.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -12,30 +11,18 @@
 
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
+#include "support/run_cli.h"
 #include "synth_test_util.h"
 
 namespace lumigauss {
 namespace {
 
 using synth_test::TempDir;
+using testing::CommandResult;
 using ::testing::HasSubstr;
+using testing::run_lumigauss;
+using testing::shell_quoted;
 namespace fs = std::filesystem;
-
-struct CommandResult {
-    int exit_code = -1;
-    std::string output;
-};
-
-CommandResult run_lumigauss(const std::string& args, const TempDir& tmp) {
-    const std::string out = tmp.sub("output.txt");
-    const std::string command = std::string("'") + LUMIGAUSS_BINARY + "' " + args + " > '" + out + "' 2>&1";
-    const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, synth_test::read_bytes(out)};
-}
-
-std::string shell_quoted(const std::string& s) {
-    return "'" + s + "'";
-}
 
 // The tiny scene and a 50-iteration run on it, made once per test process.
 struct TinyRun {

@@ -3,7 +3,6 @@
 // (import), and bad input fails naming the format or the file.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -13,30 +12,18 @@
 #include "lumigauss/scene/relightable_ply.h"
 #include "lumigauss/scene/splat_ply.h"
 #include "lumigauss/train/run_folder.h"
+#include "support/run_cli.h"
 #include "synth_test_util.h"
 
 namespace lumigauss {
 namespace {
 
 using synth_test::TempDir;
+using testing::CommandResult;
 using ::testing::HasSubstr;
+using testing::run_lumigauss;
+using testing::shell_quoted;
 namespace fs = std::filesystem;
-
-struct CommandResult {
-    int exit_code = -1;
-    std::string output;
-};
-
-std::string shell_arg(const std::string& s) {
-    return "'" + s + "'";
-}
-
-CommandResult run_lumigauss(const std::string& args, const TempDir& tmp) {
-    const std::string out = tmp.sub("output.txt");
-    const std::string command = std::string("'") + LUMIGAUSS_BINARY + "' " + args + " > '" + out + "' 2>&1";
-    const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, synth_test::read_bytes(out)};
-}
 
 // A tiny scene and a 30-iteration run on it, made once per test process.
 struct TinyRun {
@@ -46,11 +33,12 @@ struct TinyRun {
     bool ok = false;
     TinyRun() {
         const std::string scene = dir / "scene";
-        CommandResult r = run_lumigauss("synth --preset tiny -o " + shell_arg(scene), dir);
+        CommandResult r = run_lumigauss("synth --preset tiny -o " + shell_quoted(scene), dir);
         setup_output = r.output;
         if (r.exit_code != 0) return;
         r = run_lumigauss(
-            "train " + shell_arg(scene) + " -o " + shell_arg(run) + " --preset fast --iterations 30 -q", dir);
+            "train " + shell_quoted(scene) + " -o " + shell_quoted(run) + " --preset fast --iterations 30 -q",
+            dir);
         setup_output += r.output;
         ok = r.exit_code == 0;
     }
@@ -71,7 +59,7 @@ TEST(CliExport, EveryFormatAndImportFromBarePly) {
 
     // env: one SH file and one EXR per photo.
     CommandResult r = run_lumigauss(
-        "export " + shell_arg(t.run) + " --format env --width 64 -o " + shell_arg(tmp / "env"), tmp);
+        "export " + shell_quoted(t.run) + " --format env --width 64 -o " + shell_quoted(tmp / "env"), tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     std::size_t txt = 0, exr = 0;
     for (const auto& e : fs::directory_iterator(tmp / "env")) {
@@ -82,8 +70,8 @@ TEST(CliExport, EveryFormatAndImportFromBarePly) {
     EXPECT_EQ(exr, photos.size());
 
     // ply-3dgs under the first photo's learned light; readable by the 2DGS reader.
-    r = run_lumigauss("export " + shell_arg(t.run) + " --format ply-3dgs --light " + shell_arg(photos[0]) +
-                          " -o " + shell_arg(tmp / "baked/photo.ply"),
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format ply-3dgs --light " +
+                          shell_quoted(photos[0]) + " -o " + shell_quoted(tmp / "baked/photo.ply"),
                       tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(load_2dgs_ply(tmp / "baked/photo.ply").size(), surfels);
@@ -95,23 +83,24 @@ TEST(CliExport, EveryFormatAndImportFromBarePly) {
         if (c == '/' || c == '\\') c = '_';
     const std::string sh = tmp / ("env/" + sh_name + "_sh.txt");
     ASSERT_TRUE(fs::exists(sh)) << sh;
-    r = run_lumigauss("export --ply " + shell_arg(run_paths(t.run).model) + " --format ply-3dgs --light " +
-                          shell_arg(sh) + " -o " + shell_arg(tmp / "baked/imported.ply"),
+    r = run_lumigauss("export --ply " + shell_quoted(run_paths(t.run).model) + " --format ply-3dgs --light " +
+                          shell_quoted(sh) + " -o " + shell_quoted(tmp / "baked/imported.ply"),
                       tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(synth_test::read_bytes(tmp / "baked/photo.ply"),
               synth_test::read_bytes(tmp / "baked/imported.ply"));
 
     // splat: 32 bytes per surfel.
-    r = run_lumigauss("export " + shell_arg(t.run) + " --format splat --light " + shell_arg(sh) + " -o " +
-                          shell_arg(tmp / "m.splat"),
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format splat --light " + shell_quoted(sh) +
+                          " -o " + shell_quoted(tmp / "m.splat"),
                       tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(fs::file_size(tmp / "m.splat"), 32 * surfels);
 
     // ply-relightable + sidecar.
     r = run_lumigauss(
-        "export " + shell_arg(t.run) + " --format ply-relightable -o " + shell_arg(tmp / "rel.ply"), tmp);
+        "export " + shell_quoted(t.run) + " --format ply-relightable -o " + shell_quoted(tmp / "rel.ply"),
+        tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(load_relightable_ply(tmp / "rel.ply").size(), surfels);
     EXPECT_EQ(read_environment_sidecar(tmp / "rel.environments.json").environments.size(), photos.size());
@@ -122,21 +111,22 @@ TEST(CliExport, BadInputNamesTheProblem) {
     ASSERT_TRUE(t.ok) << t.setup_output;
     TempDir tmp("cli_export_bad");
     CommandResult r =
-        run_lumigauss("export " + shell_arg(t.run) + " --format obj -o " + shell_arg(tmp / "x"), tmp);
+        run_lumigauss("export " + shell_quoted(t.run) + " --format obj -o " + shell_quoted(tmp / "x"), tmp);
     EXPECT_NE(r.exit_code, 0);
     EXPECT_THAT(r.output, HasSubstr("--format 'obj'"));
 
     const std::string missing = tmp / "no_such_run";
-    r = run_lumigauss("export " + shell_arg(missing) + " --format env -o " + shell_arg(tmp / "e"), tmp);
+    r = run_lumigauss("export " + shell_quoted(missing) + " --format env -o " + shell_quoted(tmp / "e"), tmp);
     EXPECT_NE(r.exit_code, 0);
     EXPECT_THAT(r.output, HasSubstr(missing));
 
-    r = run_lumigauss("export " + shell_arg(t.run) + " --format splat -o " + shell_arg(tmp / "m.splat"), tmp);
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format splat -o " + shell_quoted(tmp / "m.splat"),
+                      tmp);
     EXPECT_NE(r.exit_code, 0);
     EXPECT_THAT(r.output, HasSubstr("--light"));
 
-    r = run_lumigauss("export " + shell_arg(t.run) + " --format ply-3dgs --light " +
-                          shell_arg(tmp / "nope.txt") + " -o " + shell_arg(tmp / "m.ply"),
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format ply-3dgs --light " +
+                          shell_quoted(tmp / "nope.txt") + " -o " + shell_quoted(tmp / "m.ply"),
                       tmp);
     EXPECT_NE(r.exit_code, 0);
     EXPECT_THAT(r.output, HasSubstr("nope.txt"));
@@ -144,7 +134,8 @@ TEST(CliExport, BadInputNamesTheProblem) {
 
     // A bare PLY has no photos to export.
     r = run_lumigauss(
-        "export " + shell_arg(run_paths(t.run).model) + " --format env -o " + shell_arg(tmp / "e2"), tmp);
+        "export " + shell_quoted(run_paths(t.run).model) + " --format env -o " + shell_quoted(tmp / "e2"),
+        tmp);
     EXPECT_NE(r.exit_code, 0);
     EXPECT_THAT(r.output, HasSubstr("no learned environments"));
 }

@@ -6,7 +6,6 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -21,32 +20,18 @@
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/train/trained_run.h"
 #include "lumigauss/train/view_shading.h"
+#include "support/run_cli.h"
 #include "synth_test_util.h"
 
 namespace lumigauss {
 namespace {
 
 using synth_test::TempDir;
+using testing::CommandResult;
 using ::testing::HasSubstr;
+using testing::run_lumigauss;
+using testing::shell_quoted;
 namespace fs = std::filesystem;
-
-struct CommandResult {
-    int exit_code = -1;
-    std::string output;
-};
-
-std::string q(const std::string& s) {
-    return "'" + s + "'";
-}
-
-// Runs the tool with `args`; `env` is put in front (e.g. "PATH=...:$PATH").
-CommandResult run_lumigauss(const std::string& args, const TempDir& tmp, const std::string& env = "") {
-    const std::string out = tmp / "output.txt";
-    const std::string command =
-        (env.empty() ? "" : env + " ") + q(LUMIGAUSS_BINARY) + " " + args + " > " + q(out) + " 2>&1";
-    const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, synth_test::read_bytes(out)};
-}
 
 // The tiny scene and a 30-iteration run on it, made once per test process.
 struct TinyRun {
@@ -55,8 +40,9 @@ struct TinyRun {
     CommandResult train;
     TinyRun() {
         synth::generate_synthetic_scene(synth_test::tiny_options(scene));
-        train =
-            run_lumigauss("train " + q(scene) + " -o " + q(run) + " --preset fast --iterations 30 -q", dir);
+        train = run_lumigauss(
+            "train " + shell_quoted(scene) + " -o " + shell_quoted(run) + " --preset fast --iterations 30 -q",
+            dir);
     }
 };
 
@@ -75,11 +61,11 @@ std::string fake_ffmpeg_path_env(const TempDir& tmp) {
     const std::string script = tmp / "bin/ffmpeg";
     {
         std::ofstream f(script);
-        f << "#!/bin/sh\necho \"$@\" >> " << q(tmp / "ffmpeg_args.txt")
+        f << "#!/bin/sh\necho \"$@\" >> " << shell_quoted(tmp / "ffmpeg_args.txt")
           << "\nfor a in \"$@\"; do last=$a; done\necho fake > \"$last\"\n";
     }
     ::chmod(script.c_str(), 0755);
-    return "PATH=" + q(tmp / "bin") + ":\"$PATH\"";
+    return "PATH=" + shell_quoted(tmp / "bin") + ":\"$PATH\"";
 }
 
 const std::vector<std::string> kPngMaps = {
@@ -113,15 +99,17 @@ TEST(CliRelight, EveryLightKindWritesEveryMapAtTheCameraSize) {
     TempDir tmp("cli_relight_kinds");
     const std::vector<std::pair<std::string, std::string>> lights = {
         {"photo", "--light train_0003.png"},
-        {"sh", "--light " + q(t.scene + "/env/sky01_sh.txt")},
-        {"exr", "--light " + q(t.scene + "/env/sky01.exr") + " --exposure 0.5"},
-        {"ldr", "--light " + q(t.scene + "/env/sky01.png") +
+        {"sh", "--light " + shell_quoted(t.scene + "/env/sky01_sh.txt")},
+        {"exr", "--light " + shell_quoted(t.scene + "/env/sky01.exr") + " --exposure 0.5"},
+        {"ldr", "--light " + shell_quoted(t.scene + "/env/sky01.png") +
                     " --hdr-threshold 0.95 --hdr-scale 10 --match-exposure"},
     };
     for (const auto& [kind, light] : lights) {
         const std::string out = tmp / kind;
-        const CommandResult r = run_lumigauss(
-            "render " + q(t.run) + " --scene " + q(t.scene) + " " + light + " -o " + q(out), tmp);
+        const CommandResult r =
+            run_lumigauss("render " + shell_quoted(t.run) + " --scene " + shell_quoted(t.scene) + " " +
+                              light + " -o " + shell_quoted(out),
+                          tmp);
         ASSERT_EQ(r.exit_code, 0) << kind << "\n" << r.output;
         for (const View* v : test_views(scene))
             expect_every_map(out, fs::path(v->name).stem().string(), v->camera.width, v->camera.height);
@@ -129,10 +117,11 @@ TEST(CliRelight, EveryLightKindWritesEveryMapAtTheCameraSize) {
         EXPECT_FALSE(fs::exists(out + "/train_0000_shadowed.png")) << kind;
     }
     // The boost was applied and said so.
-    const CommandResult r = run_lumigauss("render " + q(t.run) + " --scene " + q(t.scene) + " --light " +
-                                              q(t.scene + "/env/sky01.png") +
-                                              " --hdr-threshold 0.5 --hdr-scale 10 -o " + q(tmp / "boost"),
-                                          tmp);
+    const CommandResult r =
+        run_lumigauss("render " + shell_quoted(t.run) + " --scene " + shell_quoted(t.scene) + " --light " +
+                          shell_quoted(t.scene + "/env/sky01.png") +
+                          " --hdr-threshold 0.5 --hdr-scale 10 -o " + shell_quoted(tmp / "boost"),
+                      tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_THAT(r.output, HasSubstr("fake HDR boost"));
 }
@@ -142,9 +131,10 @@ TEST(CliRelight, PhotoLightRenderIsTheLibraryRender) {
     ASSERT_EQ(t.train.exit_code, 0) << t.train.output;
     TempDir tmp("cli_relight_known");
     const std::string out = tmp / "out";
-    const CommandResult r = run_lumigauss("render " + q(t.run) + " --scene " + q(t.scene) +
-                                              " --cameras all --light train_0002 -o " + q(out) + " -q",
-                                          tmp);
+    const CommandResult r =
+        run_lumigauss("render " + shell_quoted(t.run) + " --scene " + shell_quoted(t.scene) +
+                          " --cameras all --light train_0002 -o " + shell_quoted(out) + " -q",
+                      tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     const TrainedRun run = load_trained_run(t.run);
     const int index = run.find_image("train_0002.png");
@@ -177,11 +167,12 @@ TEST(CliRelight, SpinWritesNumberedFramesAndAVideo) {
     TempDir tmp("cli_relight_spin");
     const std::string env = fake_ffmpeg_path_env(tmp);
     const std::string out = tmp / "spin";
-    const CommandResult r = run_lumigauss("render " + q(t.run) + " --scene " + q(t.scene) +
-                                              " --light train_0001.png --view test_0000 --spin 3 --outputs "
-                                              "shadowed,shadow -o " +
-                                              q(out),
-                                          tmp, env);
+    const CommandResult r =
+        run_lumigauss("render " + shell_quoted(t.run) + " --scene " + shell_quoted(t.scene) +
+                          " --light train_0001.png --view test_0000 --spin 3 --outputs "
+                          "shadowed,shadow -o " +
+                          shell_quoted(out),
+                      tmp, env);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     for (int k = 0; k < 3; ++k) {
         const std::string stem = out + "/test_0000_spin00" + std::to_string(k);
@@ -199,8 +190,9 @@ TEST(CliRelight, SpinWritesNumberedFramesAndAVideo) {
 
     // Frame 0 is the unturned render; frame 1 differs.
     const std::string plain = tmp / "plain";
-    ASSERT_EQ(run_lumigauss("render " + q(t.run) + " --scene " + q(t.scene) +
-                                " --light train_0001.png --view test_0000 --outputs shadowed -o " + q(plain),
+    ASSERT_EQ(run_lumigauss("render " + shell_quoted(t.run) + " --scene " + shell_quoted(t.scene) +
+                                " --light train_0001.png --view test_0000 --outputs shadowed -o " +
+                                shell_quoted(plain),
                             tmp)
                   .exit_code,
               0);
@@ -210,9 +202,9 @@ TEST(CliRelight, SpinWritesNumberedFramesAndAVideo) {
     // --no-video: frames only.
     const std::string quiet = tmp / "novideo";
     ASSERT_EQ(run_lumigauss(
-                  "render " + q(t.run) + " --scene " + q(t.scene) +
+                  "render " + shell_quoted(t.run) + " --scene " + shell_quoted(t.scene) +
                       " --light train_0001.png --view test_0000 --spin 2 --no-video --outputs shadowed -o " +
-                      q(quiet),
+                      shell_quoted(quiet),
                   tmp, env)
                   .exit_code,
               0);
@@ -226,10 +218,11 @@ TEST(CliRelight, OrbitWritesATurntableWhoseCamerasReadBack) {
     TempDir tmp("cli_relight_orbit");
     const std::string env = fake_ffmpeg_path_env(tmp);
     const std::string out = tmp / "orbit";
-    const CommandResult r = run_lumigauss("render " + q(t.run) + " --scene " + q(t.scene) + " --light " +
-                                              q(t.scene + "/env/sky02_sh.txt") +
-                                              " --cameras orbit --frames 5 --rotate 30 -o " + q(out),
-                                          tmp, env);
+    const CommandResult r =
+        run_lumigauss("render " + shell_quoted(t.run) + " --scene " + shell_quoted(t.scene) + " --light " +
+                          shell_quoted(t.scene + "/env/sky02_sh.txt") +
+                          " --cameras orbit --frames 5 --rotate 30 -o " + shell_quoted(out),
+                      tmp, env);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     const Dataset scene = load_dataset(t.scene);
     const Camera& first = scene.views.front().camera;
@@ -242,11 +235,11 @@ TEST(CliRelight, OrbitWritesATurntableWhoseCamerasReadBack) {
 
     // The JSON path renders the same frame.
     const std::string again = tmp / "again";
-    const CommandResult r2 =
-        run_lumigauss("render " + q(t.run) + " --light " + q(t.scene + "/env/sky02_sh.txt") + " --cameras " +
-                          q(out + "/orbit_cameras.json") +
-                          " --view orbit_002 --rotate 30 --outputs shadowed -o " + q(again),
-                      tmp);
+    const CommandResult r2 = run_lumigauss(
+        "render " + shell_quoted(t.run) + " --light " + shell_quoted(t.scene + "/env/sky02_sh.txt") +
+            " --cameras " + shell_quoted(out + "/orbit_cameras.json") +
+            " --view orbit_002 --rotate 30 --outputs shadowed -o " + shell_quoted(again),
+        tmp);
     ASSERT_EQ(r2.exit_code, 0) << r2.output;
     EXPECT_EQ(synth_test::read_bytes(again + "/orbit_002_shadowed.png"),
               synth_test::read_bytes(out + "/orbit_002_shadowed.png"));
@@ -258,7 +251,8 @@ TEST(CliRelight, BadInputNamesTheFileAndWritesNothing) {
     ASSERT_EQ(t.train.exit_code, 0) << t.train.output;
     TempDir tmp("cli_relight_errors");
     const std::string out = tmp / "out";
-    const std::string base = "render " + q(t.run) + " --scene " + q(t.scene) + " -o " + q(out) + " ";
+    const std::string base = "render " + shell_quoted(t.run) + " --scene " + shell_quoted(t.scene) + " -o " +
+                             shell_quoted(out) + " ";
 
     // A run folder without model.ply.
     const std::string broken = tmp / "broken_run";
@@ -280,20 +274,22 @@ TEST(CliRelight, BadInputNamesTheFileAndWritesNothing) {
     };
     const std::vector<Case> cases = {
         {base + "--light no_such_photo", {"no_such_photo", "train_0000.png", "appearance.json"}},
-        {"render " + q(broken) + " --scene " + q(t.scene) + " -o " + q(out) + " --light train_0000.png",
+        {"render " + shell_quoted(broken) + " --scene " + shell_quoted(t.scene) + " -o " + shell_quoted(out) +
+             " --light train_0000.png",
          {"model.ply", "missing"}},
-        {base + "--light " + q(tmp / "bad.png"), {"bad.png"}},
-        {base + "--light " + q(tmp / "missing.exr"), {"missing.exr"}},
-        {base + "--light train_0000.png --cameras " + q(tmp / "cams.json"),
+        {base + "--light " + shell_quoted(tmp / "bad.png"), {"bad.png"}},
+        {base + "--light " + shell_quoted(tmp / "missing.exr"), {"missing.exr"}},
+        {base + "--light train_0000.png --cameras " + shell_quoted(tmp / "cams.json"),
          {"cams.json", "cameras[1]", "fx"}},
         {base + "--light train_0000.png --cameras nowhere.json", {"nowhere.json"}},
-        {"render " + q(t.run) + " --light train_0000.png --cameras orbit -o " + q(out), {"--scene"}},
+        {"render " + shell_quoted(t.run) + " --light train_0000.png --cameras orbit -o " + shell_quoted(out),
+         {"--scene"}},
         {base + "--light train_0000.png --view nope", {"nope", "test_0000"}},
         {base + "--light train_0000.png --up sideways", {"sideways"}},
         {base + "--light train_0000.png --outputs shadowed,colour", {"colour"}},
         {base + "--light train_0000.png --cameras orbit --spin 4", {"--spin"}},
         {base, {"--light"}},
-        {"render --scene " + q(t.scene) + " -o " + q(out), {"--ply"}},
+        {"render --scene " + shell_quoted(t.scene) + " -o " + shell_quoted(out), {"--ply"}},
     };
     for (const Case& c : cases) {
         const CommandResult r = run_lumigauss(c.args, tmp);

@@ -3,7 +3,6 @@
 // --force is given, and bad input fails with a message naming the file or key.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -20,26 +19,18 @@
 #include "lumigauss/train/checkpoint.h"
 #include "lumigauss/train/lighting_mlp.h"
 #include "lumigauss/train/run_folder.h"
+#include "support/run_cli.h"
 #include "synth_test_util.h"
 
 namespace lumigauss {
 namespace {
 
 using synth_test::TempDir;
+using testing::CommandResult;
 using ::testing::HasSubstr;
+using testing::run_lumigauss;
+using testing::shell_quoted;
 namespace fs = std::filesystem;
-
-struct CommandResult {
-    int exit_code = -1;
-    std::string output;
-};
-
-CommandResult run_lumigauss(const std::string& args, const TempDir& tmp) {
-    const std::string out = tmp.sub("output.txt");
-    const std::string command = std::string("'") + LUMIGAUSS_BINARY + "' " + args + " > '" + out + "' 2>&1";
-    const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, synth_test::read_bytes(out)};
-}
 
 // The tiny scene, generated once per test process.
 const std::string& tiny_scene() {
@@ -51,10 +42,6 @@ const std::string& tiny_scene() {
     return root;
 }
 
-std::string quoted(const std::string& s) {
-    return "'" + s + "'";
-}
-
 // A 60-iteration run through all three stages: stage 1 to 29, stage 2 30..35, stage 3 from 36;
 // densification at 20 and 40 (30 is in stage 2), an opacity reset at 40; a log line every 5 iterations.
 const std::string kSchedule =
@@ -64,7 +51,7 @@ const std::string kSchedule =
     " --set checkpoint_interval=20 -q";
 
 std::string train_args(const std::string& run, const std::string& extra = kSchedule) {
-    return "train " + quoted(tiny_scene()) + " -o " + quoted(run) + extra;
+    return "train " + shell_quoted(tiny_scene()) + " -o " + shell_quoted(run) + extra;
 }
 
 const std::vector<std::string> kRunFiles = {"config.json", "log.jsonl",      "checkpoint.lgck",
@@ -183,8 +170,8 @@ TEST(CliTrain, StopAfterThenResumeIsByteIdentical) {
         std::ofstream log(split + "/log.jsonl", std::ios::app);
         log << R"({"iteration":30,"stage":2,"total":123})" << '\n';
     }
-    const CommandResult c =
-        run_lumigauss("train " + quoted(tiny_scene()) + " -o " + quoted(split) + " --resume -q", tmp);
+    const CommandResult c = run_lumigauss(
+        "train " + shell_quoted(tiny_scene()) + " -o " + shell_quoted(split) + " --resume -q", tmp);
     ASSERT_EQ(c.exit_code, 0) << c.output;
     EXPECT_THAT(c.output, HasSubstr("resuming"));
 
@@ -244,8 +231,8 @@ TEST(CliTrain, BadInputFailsNamingTheFileOrKey) {
     TempDir tmp("cli_train_bad");
     {
         const std::string missing = tmp / "no_such_scene";
-        const CommandResult r =
-            run_lumigauss("train " + quoted(missing) + " -o " + quoted(tmp / "run1") + " -q", tmp);
+        const CommandResult r = run_lumigauss(
+            "train " + shell_quoted(missing) + " -o " + shell_quoted(tmp / "run1") + " -q", tmp);
         EXPECT_NE(r.exit_code, 0);
         EXPECT_THAT(r.output, HasSubstr("no_such_scene"));
         EXPECT_FALSE(fs::exists(tmp / "run1/checkpoint.lgck"));
@@ -260,7 +247,7 @@ TEST(CliTrain, BadInputFailsNamingTheFileOrKey) {
         const std::string bad = tmp / "bad_config.json";
         std::ofstream(bad) << "{ \"iterations\": 10, ";
         const CommandResult r =
-            run_lumigauss(train_args(tmp / "run3", " --config " + quoted(bad) + " -q"), tmp);
+            run_lumigauss(train_args(tmp / "run3", " --config " + shell_quoted(bad) + " -q"), tmp);
         EXPECT_NE(r.exit_code, 0);
         EXPECT_THAT(r.output, HasSubstr(bad));
         EXPECT_FALSE(fs::exists(tmp / "run3"));

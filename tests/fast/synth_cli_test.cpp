@@ -1,29 +1,20 @@
 // `lumigauss synth`: the built binary writes a loadable dataset and reports bad options as errors.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdlib>
 
 #include "lumigauss/io/dataset.h"
+#include "support/run_cli.h"
 #include "synth_test_util.h"
 
 namespace lumigauss {
 namespace {
 
 using synth_test::TempDir;
+using testing::CommandResult;
+using testing::run_lumigauss;
+using testing::shell_quoted;
 namespace fs = std::filesystem;
-
-struct CommandResult {
-    int exit_code = -1;
-    std::string output;
-};
-
-CommandResult run_lumigauss(const std::string& args, const TempDir& tmp) {
-    const std::string out = tmp.sub("output.txt");
-    const std::string command = std::string("'") + LUMIGAUSS_BINARY + "' " + args + " > '" + out + "' 2>&1";
-    const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, synth_test::read_bytes(out)};
-}
 
 TEST(SynthCli, WritesTheTinyPresetWithOverrides) {
     TempDir tmp("synth_cli");

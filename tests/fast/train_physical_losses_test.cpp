@@ -22,10 +22,12 @@
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/train/physical_losses.h"
 #include "lumigauss/train/view_shading.h"
+#include "support/finite_difference.h"
 
 namespace lumigauss {
 namespace {
 
+using testing::central_difference;
 double uni(std::mt19937_64& rng, double lo = -1.0, double hi = 1.0) {
     return std::uniform_real_distribution<double>(lo, hi)(rng);
 }
@@ -79,20 +81,6 @@ ViewNormals random_normals(std::size_t n, std::mt19937_64& rng) {
 void near_constant_transfer(std::mt19937_64& rng, double value, double t[kShCount]) {
     for (int k = 0; k < kShCount; ++k) t[k] = 0.05 * uni(rng);
     t[0] = value / sh_const::kY00;
-}
-
-// Central difference of f() w.r.t. the float x, divided by the step actually taken in float. The losses
-// are computed in double from the float parameters, so small steps are accurate.
-template <typename F>
-double central_difference(float& x, double h, F&& f) {
-    const float x0 = x;
-    const float hi = float(double(x0) + h), lo = float(double(x0) - h);
-    x = hi;
-    const double f_hi = f();
-    x = lo;
-    const double f_lo = f();
-    x = x0;
-    return (f_hi - f_lo) / (double(hi) - double(lo));
 }
 
 bool all_zero(std::span<const float> v) {

@@ -21,11 +21,13 @@
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/train/view_shading.h"
 #include "lumigauss/util/error.h"
+#include "support/finite_difference.h"
 #include "support/random_surfels.h"
 
 namespace lumigauss {
 namespace {
 
+using testing::central_difference;
 double uni(std::mt19937_64& rng, double lo = -1.0, double hi = 1.0) {
     return std::uniform_real_distribution<double>(lo, hi)(rng);
 }
@@ -146,19 +148,6 @@ double weighted_colour_sum(const GaussianModel& m, const Camera& cam, const ShCo
     double l = 0;
     for (std::size_t j = 0; j < b.colors.size(); ++j) l += double(w[j]) * double(b.colors[j]);
     return l;
-}
-
-// Central difference of f() w.r.t. the float x, divided by the step actually taken in float.
-template <typename F>
-double central_difference(float& x, double h, F&& f) {
-    const float x0 = x;
-    const float hi = float(double(x0) + h), lo = float(double(x0) - h);
-    x = hi;
-    const double f_hi = f();
-    x = lo;
-    const double f_lo = f();
-    x = x0;
-    return (f_hi - f_lo) / (double(hi) - double(lo));
 }
 
 constexpr double kStep = 2e-3;
