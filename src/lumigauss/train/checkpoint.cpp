@@ -44,6 +44,17 @@ class Writer {
     std::ofstream& out_;
 };
 
+struct SavedAdam {
+    std::int64_t step = 0;
+    std::vector<float> m, v;
+};
+
+void restore_adam(AdamGroup& g, SavedAdam a, const std::string& path, const std::string& what) {
+    if (a.m.size() != g.size() || a.v.size() != g.size())
+        fail_in_file(path, "corrupt checkpoint (optimizer state of " + what + " has the wrong size)");
+    g.restore(a.step, std::move(a.m), std::move(a.v));
+}
+
 class Reader {
   public:
     Reader(std::ifstream& in, const std::string& path) : in_(in), path_(path) {}
@@ -73,14 +84,13 @@ class Reader {
         raw(v.data(), v.size() * sizeof(float), what);
         return v;
     }
-    void adam(AdamGroup& g, const char* what) {
-        const auto step = value<std::int64_t>(what);
-        auto m = floats(what);
-        auto v = floats(what);
-        if (m.size() != g.size() || v.size() != g.size())
-            fail_in_file(path_, std::string("corrupt checkpoint (optimizer state of ") + what +
-                                    " has the wrong size)");
-        g.restore(step, std::move(m), std::move(v));
+    // An optimizer state as Writer::adam wrote it; put back with restore_adam once its group exists.
+    SavedAdam adam(const char* what) {
+        SavedAdam a;
+        a.step = value<std::int64_t>(what);
+        a.m = floats(what);
+        a.v = floats(what);
+        return a;
     }
 
   private:
@@ -140,27 +150,18 @@ TrainState load_checkpoint(const std::string& path) {
 
     const auto surfels = r.length("surfel count");
     std::vector<std::vector<float>> raw(kModelParamCount);
-    struct SavedAdam {
-        std::int64_t step;
-        std::vector<float> m, v;
-    };
     std::vector<SavedAdam> adam(kModelParamCount);
     for (int p = 0; p < kModelParamCount; ++p) {
         raw[std::size_t(p)] = r.floats("surfel parameters");
         if (raw[std::size_t(p)].size() != surfels * std::size_t(GaussianModel::width(ModelParam(p))))
             fail_in_file(path, std::string("corrupt checkpoint (") + GaussianModel::name(ModelParam(p)) +
                                    " has the wrong size)");
-        adam[std::size_t(p)].step = r.value<std::int64_t>("surfel optimizer");
-        adam[std::size_t(p)].m = r.floats("surfel optimizer");
-        adam[std::size_t(p)].v = r.floats("surfel optimizer");
+        adam[std::size_t(p)] = r.adam("surfel optimizer");
     }
     s.model = GaussianModel::from_raw(std::move(raw), s.scene_extent, model_learning_rates(s.config));
-    for (int p = 0; p < kModelParamCount; ++p) {
-        auto& a = adam[std::size_t(p)];
-        if (a.m.size() != s.model.adam(ModelParam(p)).size() || a.v.size() != a.m.size())
-            fail_in_file(path, "corrupt checkpoint (surfel optimizer state has the wrong size)");
-        s.model.adam(ModelParam(p)).restore(a.step, std::move(a.m), std::move(a.v));
-    }
+    for (int p = 0; p < kModelParamCount; ++p)
+        restore_adam(s.model.adam(ModelParam(p)), std::move(adam[std::size_t(p)]), path,
+                     GaussianModel::name(ModelParam(p)));
     auto accum = r.floats("densification statistics");
     auto count = r.floats("densification statistics");
     auto radii = r.floats("densification statistics");
@@ -179,7 +180,8 @@ TrainState load_checkpoint(const std::string& path) {
             fail_in_file(path, std::string("corrupt checkpoint (lighting ") + mlp_group_name(MlpGroup(g)) +
                                    " has the wrong size)");
         s.lighting.param(MlpGroup(g)) = std::move(values);
-        r.adam(s.lighting_adam[std::size_t(g)], mlp_group_name(MlpGroup(g)));
+        restore_adam(s.lighting_adam[std::size_t(g)], r.adam(mlp_group_name(MlpGroup(g))), path,
+                     mlp_group_name(MlpGroup(g)));
     }
     char end[8];
     r.raw(end, 8, "end marker");

@@ -257,9 +257,20 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     const ImageShape shape{view.rgb.width, view.rgb.height, 3};
     std::span<const float> target = view.rgb.pixels, mask = view.mask.pixels;
     RasterImageGrads<float>& g = s.image_grads;
-    g = RasterImageGrads<float>{};
+    // The buffers keep their capacity from iteration to iteration (assign/clear do not free): no allocation
+    // in the loop. Maps without a loss this iteration stay empty, so the backward skips them.
+    const bool regularize = it > c.start_regularization;
+    const std::size_t pixels = shape.pixels();
     g.width = shape.width, g.height = shape.height, g.channels = channels;
     g.color.assign(s.images.color.size(), 0.0f);
+    const auto reset = [&](std::vector<float>& map, std::size_t size) {
+        if (regularize)
+            map.assign(size, 0.0f);
+        else
+            map.clear();
+    };
+    reset(g.alpha, pixels), reset(g.depth, pixels), reset(g.distortion, pixels), reset(g.normal, 3 * pixels);
+    g.median_depth.clear();
     const auto photometric = [&](int first, double weight, double& l1, double& dssim) -> double {
         extract_rgb(s.images.color, channels, first, s.rendered);
         s.grad_rendered.assign(s.rendered.size(), 0.0f);
@@ -283,7 +294,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
                                                     c.lambda_dssim * report.dssim_unshadowed);
     }
     report.total += image_total;
-    if (it > c.start_regularization) {
+    if (regularize) {
         report.normal =
             normal_consistency_loss<float>(view.camera, s.images, mask, float(c.lambda_normal), &g);
         report.distortion = distortion_loss<float>(s.images, mask, float(c.lambda_distortion), &g);
