@@ -6,6 +6,7 @@ namespace lumigauss::cli {
 
 void register_eval(CLI::App& app);
 void register_export(CLI::App& app);
+void register_fit_light(CLI::App& app);
 void register_info(CLI::App& app);
 void register_render(CLI::App& app);
 void register_synth(CLI::App& app);

@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", "lumigauss 0.1.0");
     lumigauss::cli::register_eval(app);
     lumigauss::cli::register_export(app);
+    lumigauss::cli::register_fit_light(app);
     lumigauss::cli::register_info(app);
     lumigauss::cli::register_render(app);
     lumigauss::cli::register_synth(app);

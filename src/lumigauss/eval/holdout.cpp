@@ -1,0 +1,126 @@
+#include "lumigauss/eval/holdout.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "lumigauss/relight/relit_render.h"
+#include "lumigauss/render/raster_maps.h"
+#include "lumigauss/util/error.h"
+
+namespace lumigauss {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+    return 1e3 * std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Zeroes the columns outside [x0, x1).
+Image keep_columns(Image mask, int x0, int x1) {
+    for (int y = 0; y < mask.height; ++y)
+        for (int x = 0; x < mask.width; ++x)
+            if (x < x0 || x >= x1) mask.at(x, y, 0) = 0.0f;
+    return mask;
+}
+
+Image mask_or_ones(const Image& scene_mask, int width, int height) {
+    if (scene_mask.empty()) return Image(width, height, 1, 1.0f);
+    if (scene_mask.width != width || scene_mask.height != height || scene_mask.channels != 1)
+        throw Error("holdout: the mask is not one channel of the image's size");
+    return scene_mask;
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0;
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+void add_metrics(ImageMetrics& sum, const ImageMetrics& m) {
+    sum.psnr += m.psnr, sum.ssim += m.ssim, sum.mse += m.mse, sum.mae += m.mae;
+}
+
+void divide_metrics(ImageMetrics& m, double n) {
+    m.psnr /= n, m.ssim /= n, m.mse /= n, m.mae /= n;
+}
+
+HoldoutImageResult evaluate_view(const TrainedRun& run, const Dataset& scene, const View& view,
+                                 RelitRenderer& renderer, const HoldoutOptions& options) {
+    HoldoutImageResult r;
+    r.name = view.name;
+    const int w = view.camera.width, h = view.camera.height;
+    HoldoutPanels& p = r.panels;
+    p.truth = scene.load_image(view);
+    const Image scene_mask = scene.load_mask(view);
+    p.fit_mask = holdout_fit_mask(scene_mask, w, h);
+    p.score_mask = holdout_score_mask(scene_mask, w, h);
+    r.fit_pixels = mask_pixels(p.fit_mask);
+    r.score_pixels = mask_pixels(p.score_mask);
+    if (r.fit_pixels == 0) throw Error(view.image_path + ": holdout: the left half has no pixel to fit");
+    if (r.score_pixels == 0)
+        throw Error(view.image_path + ": holdout: the right half has no fully covered pixel to score");
+
+    auto t0 = Clock::now();
+    const LightFitResult fit = fit_light(run, view.camera, p.truth, p.fit_mask, options.fit);
+    r.fit_ms = ms_since(t0);
+    r.fit_psnr = fit.final_psnr;
+    r.light = fit.sh;
+
+    t0 = Clock::now();
+    const RasterImages<float>& relit = renderer.render(view.camera, fit.sh.cast<float>());
+    r.render_ms = ms_since(t0);
+    p.shadowed = clamp01(raster_channels(relit, kRelitShadowed, 3));
+    p.unshadowed = clamp01(raster_channels(relit, kRelitUnshadowed, 3));
+    r.shadowed = image_metrics(p.shadowed, p.truth, p.score_mask, options.ssim);
+    r.unshadowed = image_metrics(p.unshadowed, p.truth, p.score_mask, options.ssim);
+    if (options.keep_panels) {
+        p.albedo = clamp01(raster_channels(relit, kRelitAlbedo, 3));
+        p.normal = encode_normals(relit);
+        p.shadow = shadow_image(raster_channels(relit, kRelitIntensityUnshadowed, 3),
+                                raster_channels(relit, kRelitIntensityShadowed, 3));
+    } else {
+        p = HoldoutPanels{};
+    }
+    return r;
+}
+
+}  // namespace
+
+Image holdout_fit_mask(const Image& scene_mask, int width, int height) {
+    return keep_columns(mask_or_ones(scene_mask, width, height), 0, width / 2);
+}
+
+Image holdout_score_mask(const Image& scene_mask, int width, int height) {
+    const Image binary = binarize_mask(mask_or_ones(scene_mask, width, height), 0.5f);
+    return keep_columns(official_eval_mask(binary), width / 2, width);
+}
+
+HoldoutResult evaluate_holdout(const TrainedRun& run, const Dataset& scene, const HoldoutOptions& options) {
+    HoldoutResult result;
+    result.variable = options.fit.variable;
+    result.iterations = options.fit.iterations;
+    result.views = options.views;
+    const std::vector<const View*> views = scene.split(options.views);
+    if (views.empty())
+        throw Error(scene.root + ": the scene has no " + split_name(options.views) + " image to evaluate");
+    RelitRenderer renderer(run.model);
+    std::vector<double> fit_ms, render_ms;
+    for (const View* v : views) {
+        result.images.push_back(evaluate_view(run, scene, *v, renderer, options));
+        const HoldoutImageResult& r = result.images.back();
+        add_metrics(result.mean_shadowed, r.shadowed);
+        add_metrics(result.mean_unshadowed, r.unshadowed);
+        result.mean_fit_psnr += r.fit_psnr;
+        fit_ms.push_back(r.fit_ms), render_ms.push_back(r.render_ms);
+    }
+    const double n = double(result.images.size());
+    divide_metrics(result.mean_shadowed, n);
+    divide_metrics(result.mean_unshadowed, n);
+    result.mean_fit_psnr /= n;
+    result.median_fit_ms = median(fit_ms);
+    result.median_render_ms = median(render_ms);
+    return result;
+}
+
+}  // namespace lumigauss

@@ -1,0 +1,67 @@
+#pragma once
+// The `holdout` evaluation protocol, for photo collections without ground-truth lighting (NeRF-W's
+// "appearance from the left half"): the lighting of each test photo is fitted with the model frozen
+// (relight/light_fit.h) on the LEFT half of the photo only, and the render under that light is scored on
+// the RIGHT half, which the fit never saw. Scores novel-view geometry, albedo and the transfer functions
+// under a light the model could explain, without any ground-truth environment.
+//
+//   fit mask    the scene's mask (soft values as stored; all ones without one) on columns x < W/2
+//   score mask  official_eval_mask (eval/metrics.h: 5x5 erosion, fully covered pixels) of the scene's mask
+//               binarised at 0.5, on columns x >= W/2
+// Both renders use the one fitted light: the shadowed fit (default) scores shadowed and unshadowed alike,
+// as the sol-nerf protocol scores both with the angle picked on the shadowed render.
+#include <string>
+#include <vector>
+
+#include "lumigauss/eval/metrics.h"
+#include "lumigauss/io/dataset.h"
+#include "lumigauss/io/image.h"
+#include "lumigauss/relight/light_fit.h"
+#include "lumigauss/shading/sh.h"
+#include "lumigauss/train/trained_run.h"
+
+namespace lumigauss {
+
+struct HoldoutOptions {
+    LightFitOptions fit;  // variable (default Embedding for a run with a lighting network), iterations, ...
+    SsimOptions ssim;     // win 5, as the official evaluation
+    Split views = Split::Test;
+    bool keep_panels = true;
+};
+
+// What the contact sheet shows (3 channels unless noted), at the evaluated resolution.
+struct HoldoutPanels {
+    Image truth, shadowed, unshadowed;  // photo and clamped renders under the fitted light
+    Image albedo, normal;               // model albedo (clamped) and normals encoded (n + 1)/2
+    Image shadow;                       // 1 channel: the paper's shadow image, 1 = lit
+    Image fit_mask, score_mask;         // 1 channel each
+};
+
+struct HoldoutImageResult {
+    std::string name;
+    std::size_t fit_pixels = 0, score_pixels = 0;
+    double fit_psnr = 0;  // masked PSNR of the fitted render on the left half (how well the fit went)
+    double fit_ms = 0, render_ms = 0;
+    ShCoeffs<double> light;             // the fitted environment SH
+    ImageMetrics shadowed, unshadowed;  // on the right half
+    HoldoutPanels panels;
+};
+
+struct HoldoutResult {
+    LightVariable variable = LightVariable::Sh;
+    int iterations = 0;
+    Split views = Split::Test;
+    std::vector<HoldoutImageResult> images;
+    ImageMetrics mean_shadowed, mean_unshadowed;  // PSNR averaged as PSNR, as officially
+    double mean_fit_psnr = 0, median_fit_ms = 0, median_render_ms = 0;
+};
+
+// Fit mask and score mask of a view (see above) from the scene's mask as loaded (empty: no mask).
+Image holdout_fit_mask(const Image& scene_mask, int width, int height);
+Image holdout_score_mask(const Image& scene_mask, int width, int height);
+
+// Runs the protocol on the views of `scene` (loaded at the resolution to evaluate). Throws Error naming
+// the image when a half has no pixel to fit or to score.
+HoldoutResult evaluate_holdout(const TrainedRun& run, const Dataset& scene, const HoldoutOptions& options);
+
+}  // namespace lumigauss

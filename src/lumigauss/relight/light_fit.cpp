@@ -1,0 +1,270 @@
+#include "lumigauss/relight/light_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <span>
+
+#include "lumigauss/eval/metrics.h"
+#include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/shading/surfel_shading.h"
+#include "lumigauss/train/adam.h"
+#include "lumigauss/train/image_losses.h"
+#include "lumigauss/train/physical_losses.h"
+#include "lumigauss/train/view_shading.h"
+#include "lumigauss/util/error.h"
+
+namespace lumigauss {
+namespace {
+
+constexpr int kShFloats = 3 * kShCount;
+
+// Flat k * 3 + channel layout for the optimizer.
+void to_flat(const ShCoeffs<float>& sh, std::span<float> flat) {
+    for (int k = 0; k < kShCount; ++k)
+        for (int c = 0; c < 3; ++c) flat[std::size_t(3 * k + c)] = sh.c[k][c];
+}
+
+ShCoeffs<float> from_flat(std::span<const float> flat) {
+    ShCoeffs<float> sh;
+    for (int k = 0; k < kShCount; ++k)
+        for (int c = 0; c < 3; ++c) sh.c[k][c] = flat[std::size_t(3 * k + c)];
+    return sh;
+}
+
+std::vector<float> mean_embedding(const LightingMlp& mlp) {
+    const std::vector<float>& table = mlp.param(MlpGroup::kEmbedding);
+    std::vector<double> sum(kEmbeddingDim, 0.0);
+    for (int i = 0; i < mlp.num_images(); ++i)
+        for (int d = 0; d < kEmbeddingDim; ++d)
+            sum[std::size_t(d)] += table[std::size_t(i * kEmbeddingDim + d)];
+    std::vector<float> mean(kEmbeddingDim);
+    for (int d = 0; d < kEmbeddingDim; ++d)
+        mean[std::size_t(d)] = float(sum[std::size_t(d)] / mlp.num_images());
+    return mean;
+}
+
+void check_inputs(const TrainedRun& run, const Camera& camera, const Image& photo, const Image& mask,
+                  const LightFitOptions& o) {
+    if (photo.width != camera.width || photo.height != camera.height || photo.channels != 3)
+        throw Error("fit-light: the photo is " + std::to_string(photo.width) + "x" +
+                    std::to_string(photo.height) + " with " + std::to_string(photo.channels) +
+                    " channels; the camera needs " + std::to_string(camera.width) + "x" +
+                    std::to_string(camera.height) + " RGB");
+    if (!mask.pixels.empty() &&
+        (mask.width != photo.width || mask.height != photo.height || mask.channels != 1))
+        throw Error("fit-light: the mask must be one channel of the photo's size");
+    if (!mask.pixels.empty() &&
+        std::none_of(mask.pixels.begin(), mask.pixels.end(), [](float m) { return m > 0; }))
+        throw Error("fit-light: the mask selects no pixel");
+    if (o.iterations < 1) throw Error("fit-light: iterations must be >= 1");
+    if (run.model.size() == 0) throw Error("fit-light: the model has no surfel");
+    if (o.variable == LightVariable::Embedding && run.lighting.num_images() == 0)
+        throw Error("fit-light: fitting an embedding needs a run with a lighting network (" + run.dir +
+                    " has none); fit the SH instead");
+    if (o.initial_embedding && o.initial_embedding->size() != std::size_t(kEmbeddingDim))
+        throw Error("fit-light: an initial embedding has " + std::to_string(kEmbeddingDim) + " values");
+}
+
+// The light as Adam sees it: a flat parameter vector and the map from it to the SH (and back for the
+// gradient).
+class LightParameters {
+  public:
+    LightParameters(const TrainedRun& run, const LightFitOptions& o) : variable_(o.variable) {
+        if (variable_ == LightVariable::Sh) {
+            values_.resize(kShFloats);
+            to_flat((o.initial_sh ? *o.initial_sh : default_initial_sh(run)).cast<float>(), values_);
+            adam_ = AdamGroup("env_sh", values_.size(), o.sh_learning_rate, 1, 1e-15);
+        } else {
+            // A private copy of the network whose row 0 holds the embedding being fitted.
+            mlp_ = run.lighting;
+            values_ = o.initial_embedding ? *o.initial_embedding : mean_embedding(run.lighting);
+            adam_ = AdamGroup("embedding", values_.size(), o.embedding_learning_rate, 1, 1e-15);
+        }
+        grads_.assign(values_.size(), 0.0f);
+        base_lr_ = adam_.lr();
+    }
+
+    ShCoeffs<float> sh() {
+        if (variable_ == LightVariable::Sh) return from_flat(values_);
+        std::copy(values_.begin(), values_.end(), mlp_.param(MlpGroup::kEmbedding).begin());
+        forward_ = mlp_.forward(0);
+        return forward_.sh;
+    }
+
+    // dLoss/dSH of the light last returned by sh() -> dLoss/dvalues.
+    void set_gradient(const ShCoeffs<float>& g_sh) {
+        if (variable_ == LightVariable::Sh) {
+            to_flat(g_sh, grads_);
+            return;
+        }
+        mlp_.zero_grad();
+        mlp_.backward(forward_, g_sh);
+        const std::vector<float>& g = mlp_.grad(MlpGroup::kEmbedding);
+        std::copy(g.begin(), g.begin() + kEmbeddingDim, grads_.begin());
+    }
+
+    void step(double lr_factor) {
+        adam_.set_lr(base_lr_ * lr_factor);
+        adam_.step(values_, grads_);
+    }
+
+    const std::vector<float>& values() const { return values_; }
+    void set_values(const std::vector<float>& v) { values_ = v; }
+
+  private:
+    LightVariable variable_;
+    std::vector<float> values_, grads_;
+    AdamGroup adam_;
+    double base_lr_ = 0;
+    LightingMlp mlp_;
+    LightingForward<float> forward_;
+};
+
+// One render of the frozen model under a light, its objective and the objective's gradient w.r.t. the SH.
+class FrozenViewObjective {
+  public:
+    FrozenViewObjective(const TrainedRun& run, const Camera& camera, const Image& photo, const Image& mask,
+                        const LightFitOptions& o)
+        : o_(o),
+          camera_(camera),
+          model_(run.model),
+          photo_(photo),
+          mask_(mask.pixels.empty() ? Image(photo.width, photo.height, 1, 1.0f) : mask) {
+        mode_ = o.shadowed ? ShadingMode::Shadowed : ShadingMode::Unshadowed;
+        model_.activated(batch_);
+        compute_view_normals(model_, camera_, normals_);
+        shape_ = ImageShape{photo.width, photo.height, 3};
+    }
+
+    struct Value {
+        double loss = 0, psnr = 0;
+        ShCoeffs<float> g_env{};
+    };
+
+    Value evaluate(const ShCoeffs<float>& env, int iteration, bool with_gradient) {
+        Value v;
+        shade_surfels(model_, env, mode_, normals_, batch_);
+        rasterize_forward_cpu(camera_, batch_, settings_, state_, images_);
+        std::span<const float> rendered = images_.color;  // 3 channels in either single mode
+        grad_.color.assign(with_gradient ? rendered.size() : 0, 0.0f);
+        std::span<float> g = grad_.color;
+        const float w1 = float(1 - o_.lambda_dssim), w2 = float(o_.lambda_dssim);
+        const double l1 = masked_l1_loss<float>(shape_, rendered, photo_.pixels, mask_.pixels, w1, g);
+        const double dssim = masked_dssim_loss<float>(shape_, rendered, photo_.pixels, mask_.pixels, w2, g);
+        const double env_loss = env_nonnegativity_loss(env, o_.env_samples, o_.seed, iteration,
+                                                       with_gradient ? o_.lambda_env : 0.0, v.g_env);
+        v.loss = w1 * l1 + w2 * dssim + o_.lambda_env * env_loss;
+        v.psnr = fitted_psnr();
+        if (with_gradient) add_render_gradient(env, v.g_env);
+        return v;
+    }
+
+    double env_loss(const ShCoeffs<float>& env, int iteration) const {
+        ShCoeffs<float> unused{};
+        return env_nonnegativity_loss(env, o_.env_samples, o_.seed, iteration, 0.0, unused);
+    }
+
+    // True when the last render put some coverage on a pixel of the mask.
+    bool sees_model() const {
+        for (std::size_t p = 0; p < mask_.pixels.size(); ++p)
+            if (mask_.pixels[p] > 0 && images_.alpha[p] > 1e-4f) return true;
+        return false;
+    }
+
+  private:
+    void add_render_gradient(const ShCoeffs<float>& env, ShCoeffs<float>& g_env) {
+        grad_.width = shape_.width, grad_.height = shape_.height, grad_.channels = 3;
+        const SurfelGrads<float> sg = rasterize_backward_cpu(batch_, state_, grad_);
+        model_.zero_grad();  // the model's own gradients are a by-product here, never used
+        const ShCoeffs<float> g_shading = shade_surfels_backward(model_, env, mode_, normals_, sg.colors);
+        for (int k = 0; k < kShCount; ++k) g_env.c[k] = g_env.c[k] + g_shading.c[k];
+    }
+
+    double fitted_psnr() const {
+        Image rendered(photo_.width, photo_.height, 3);
+        rendered.pixels = images_.color;
+        return psnr_from_mse(masked_mse(clamp01(rendered), photo_, mask_));
+    }
+
+    const LightFitOptions& o_;
+    const Camera& camera_;
+    GaussianModel model_;  // a copy: shading's backward writes (unused) gradients into it
+    const Image& photo_;
+    Image mask_;  // all ones without a mask
+    ShadingMode mode_;
+    ImageShape shape_;
+    ViewNormals normals_;
+    SurfelBatch<float> batch_;
+    RasterSettings<float> settings_;
+    RasterState<float> state_;
+    RasterImages<float> images_;
+    RasterImageGrads<float> grad_;
+};
+
+}  // namespace
+
+const char* light_variable_name(LightVariable v) {
+    return v == LightVariable::Sh ? "sh" : "embedding";
+}
+
+ShCoeffs<double> default_initial_sh(const TrainedRun& run) {
+    ShCoeffs<double> sh{};
+    const int n = int(run.image_names.size());
+    if (n == 0 || run.lighting.num_images() == 0) {
+        // E(n) = A_0 L_00 Y_00 = pi L_00 Y_00 = 1 for every normal.
+        const double dc = 1.0 / (std::numbers::pi * sh_const::kY00);
+        sh.c[0] = Vec3d{dc, dc, dc};
+        return sh;
+    }
+    for (int i = 0; i < n; ++i) {
+        const ShCoeffs<double> l = run.learned_sh(i);
+        for (int k = 0; k < kShCount; ++k) sh.c[k] = sh.c[k] + l.c[k] * (1.0 / n);
+    }
+    return sh;
+}
+
+LightFitResult fit_light(const TrainedRun& run, const Camera& camera, const Image& photo, const Image& mask,
+                         const LightFitOptions& options) {
+    check_inputs(run, camera, photo, mask, options);
+    LightParameters light(run, options);
+    FrozenViewObjective objective(run, camera, photo, mask, options);
+
+    LightFitResult result;
+    double best_loss = std::numeric_limits<double>::infinity();
+    std::vector<float> best_values = light.values();
+    const double decay = std::log(options.final_lr_fraction);
+    for (int it = 0; it < options.iterations; ++it) {
+        const ShCoeffs<float> env = light.sh();
+        const auto v = objective.evaluate(env, it, true);
+        if (!std::isfinite(v.loss))
+            throw Error("fit-light: the objective became non-finite at iteration " + std::to_string(it));
+        if (it == 0) {
+            if (!objective.sees_model())
+                throw Error("fit-light: no surfel of the model covers a pixel the fit uses (wrong camera?)");
+            result.initial_loss = v.loss, result.initial_psnr = v.psnr;
+        }
+        if (v.loss < best_loss) best_loss = v.loss, best_values = light.values();
+        if (options.progress) options.progress(it, v.loss, v.psnr);
+        light.set_gradient(v.g_env);
+        light.step(std::exp(decay * it / std::max(1, options.iterations - 1)));
+    }
+    // The last step's result has not been scored yet.
+    {
+        const ShCoeffs<float> env = light.sh();
+        const auto v = objective.evaluate(env, options.iterations, false);
+        if (std::isfinite(v.loss) && v.loss < best_loss) best_loss = v.loss, best_values = light.values();
+    }
+    light.set_values(best_values);
+    const ShCoeffs<float> env = light.sh();
+    const auto final_value = objective.evaluate(env, options.iterations, false);
+    result.sh = env.cast<double>();
+    if (options.variable == LightVariable::Embedding) result.embedding = best_values;
+    result.iterations = options.iterations;
+    result.final_loss = final_value.loss;
+    result.final_psnr = final_value.psnr;
+    result.env_loss = objective.env_loss(env, options.iterations);
+    return result;
+}
+
+}  // namespace lumigauss

@@ -1,0 +1,141 @@
+// `lumigauss fit-light`: on a short training run of the tiny synthetic scene, a test photo re-rendered by
+// the run under a known SH file is fitted back (by camera name with --scene, and by camera JSON), the SH
+// file written reproduces the photo, and bad input fails naming the problem without writing output.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+
+#include "lumigauss/eval/metrics.h"
+#include "lumigauss/io/dataset.h"
+#include "lumigauss/io/image.h"
+#include "lumigauss/relight/camera_json.h"
+#include "lumigauss/relight/light_fit.h"
+#include "lumigauss/shading/sh_text.h"
+#include "lumigauss/train/trained_run.h"
+#include "lumigauss/train/view_shading.h"
+#include "support/run_cli.h"
+#include "synth_test_util.h"
+
+namespace lumigauss {
+namespace {
+
+using synth_test::TempDir;
+using testing::CommandResult;
+using ::testing::HasSubstr;
+using testing::run_lumigauss;
+using testing::shell_quoted;
+namespace fs = std::filesystem;
+
+// The tiny scene, a 30-iteration run on it, and one test view re-rendered under a known light.
+struct FitSetup {
+    TempDir dir{"cli_fit_light"};
+    std::string scene = dir / "scene", run = dir / "run", photo = dir / "photo.png";
+    CommandResult train;
+    View view;
+    ShCoeffs<double> light;
+    FitSetup() {
+        synth::generate_synthetic_scene(synth_test::tiny_options(scene));
+        train = run_lumigauss(
+            "train " + shell_quoted(scene) + " -o " + shell_quoted(run) + " --preset fast --iterations 30 -q",
+            dir);
+        if (train.exit_code != 0) return;
+        const TrainedRun r = load_trained_run(run);
+        DatasetOptions dopt;
+        dopt.downscale = r.downscale > 0 ? r.downscale : 1;
+        const Dataset d = load_dataset(scene, dopt);
+        view = *d.split(Split::Test).front();
+        // A light unlike the training ones in colour and direction: 1.3 x photo 0's, tinted, turned.
+        light = r.learned_sh(0);
+        for (int k = 0; k < kShCount; ++k)
+            light.c[k] = Vec3d{1.3 * light.c[k][0], 1.1 * light.c[k][1], 0.8 * light.c[k][2]};
+        std::swap(light.c[1], light.c[3]);
+        write_png(photo, rendered(r, view.camera, light));
+    }
+    static Image rendered(const TrainedRun& r, const Camera& cam, const ShCoeffs<double>& sh) {
+        const RasterImages<float> img =
+            render_with_environment(r.model, cam, sh.cast<float>(), ShadingMode::Shadowed);
+        Image out(cam.width, cam.height, 3);
+        for (std::size_t i = 0; i < out.pixels.size(); ++i)
+            out.pixels[i] = std::clamp(img.color[i], 0.0f, 1.0f);
+        return out;
+    }
+    // PSNR over the pixels the model covers, of the run rendered under `sh` against the photo.
+    double psnr_with(const ShCoeffs<double>& sh) const {
+        const TrainedRun r = load_trained_run(run);
+        const Image a = rendered(r, view.camera, sh), b = read_image(photo);
+        return psnr_from_mse(masked_mse(a, to_channels(b, 3), Image(a.width, a.height, 1, 1.0f)));
+    }
+};
+
+const FitSetup& setup() {
+    static FitSetup s;
+    return s;
+}
+
+TEST(CliFitLight, FitsATestPhotoByCameraName) {
+    const FitSetup& s = setup();
+    ASSERT_EQ(s.train.exit_code, 0) << s.train.output;
+    TempDir tmp("cli_fit_light_name");
+    const std::string out = tmp / "fitted.txt", render = tmp / "fitted.png";
+    const CommandResult r = run_lumigauss(
+        "fit-light " + shell_quoted(s.run) + " --scene " + shell_quoted(s.scene) + " --camera " +
+            shell_quoted(s.view.name) + " --image " + shell_quoted(s.photo) +
+            " --via sh --iterations 300 -o " + shell_quoted(out) + " --render " + shell_quoted(render),
+        tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("fit-light: masked PSNR"));
+    ASSERT_TRUE(fs::exists(render));
+    const ShCoeffs<double> fitted = read_sh_text(out);
+    EXPECT_GT(s.psnr_with(fitted), 40.0);
+}
+
+TEST(CliFitLight, FitsThroughTheEmbeddingWithACameraJson) {
+    const FitSetup& s = setup();
+    ASSERT_EQ(s.train.exit_code, 0) << s.train.output;
+    TempDir tmp("cli_fit_light_json");
+    const std::string cams = tmp / "pose.json", out = tmp / "fitted.txt";
+    write_camera_json(cams, {{"photo", s.view.camera}});
+    const CommandResult r =
+        run_lumigauss("fit-light " + shell_quoted(s.run) + " --camera " + shell_quoted(cams) + " --image " +
+                          shell_quoted(s.photo) + " --iterations 150 -q -o " + shell_quoted(out),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    // The default for a run is the embedding; the render must improve on the mean training light.
+    const TrainedRun run = load_trained_run(s.run);
+    const ShCoeffs<double> mean = default_initial_sh(run);  // the mean learned light
+    EXPECT_GT(s.psnr_with(read_sh_text(out)), s.psnr_with(mean) + 3.0);
+}
+
+TEST(CliFitLight, BadInputFailsNamingTheProblem) {
+    const FitSetup& s = setup();
+    ASSERT_EQ(s.train.exit_code, 0) << s.train.output;
+    TempDir tmp("cli_fit_light_bad");
+    const std::string out = tmp / "never.txt";
+    const std::string base = "fit-light " + shell_quoted(s.run) + " -o " + shell_quoted(out) + " ";
+    CommandResult r =
+        run_lumigauss(base + "--scene " + shell_quoted(s.scene) + " --camera no_such_image", tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("no_such_image"));
+    r = run_lumigauss(base + "--camera " + shell_quoted(s.view.name), tmp);  // a name needs --scene
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("--scene"));
+    r = run_lumigauss(base + "--scene " + shell_quoted(s.scene) + " --camera " + shell_quoted(s.view.name) +
+                          " --image " + shell_quoted(tmp / "missing.png"),
+                      tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("missing.png"));
+    Image wide(s.view.camera.width * 2, s.view.camera.height, 3, 0.5f);  // another aspect ratio
+    write_png(tmp / "wide.png", wide);
+    r = run_lumigauss(base + "--scene " + shell_quoted(s.scene) + " --camera " + shell_quoted(s.view.name) +
+                          " --image " + shell_quoted(tmp / "wide.png"),
+                      tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("aspect ratio"));
+    EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace
+}  // namespace lumigauss

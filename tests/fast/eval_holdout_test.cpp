@@ -1,0 +1,136 @@
+// The holdout protocol (eval/holdout.h): the masks split each photo into a left half to fit and a right half
+// to score; on a copy of the tiny scene whose test photos are the run's own renders under one known light,
+// the light fitted on the left half reproduces the right half (so the right half scores high), while a
+// photo whose right half was changed scores low there although the fit on the left is as good as before.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+
+#include "lumigauss/eval/holdout.h"
+#include "lumigauss/io/dataset.h"
+#include "lumigauss/io/image.h"
+#include "lumigauss/train/trained_run.h"
+#include "lumigauss/train/view_shading.h"
+#include "lumigauss/util/error.h"
+#include "support/run_cli.h"
+#include "synth_test_util.h"
+
+namespace lumigauss {
+namespace {
+
+using synth_test::TempDir;
+using testing::run_lumigauss;
+using testing::shell_quoted;
+namespace fs = std::filesystem;
+
+TEST(HoldoutMasks, LeftHalfFitsRightHalfScores) {
+    Image scene_mask(10, 8, 1, 1.0f);
+    scene_mask.at(1, 4, 0) = 0.3f;  // soft value on the left: kept as it is for the fit
+    scene_mask.at(7, 4, 0) = 0.3f;  // on the right: below 0.5, a hole in the score mask
+    const Image fit = holdout_fit_mask(scene_mask, 10, 8);
+    const Image score = holdout_score_mask(scene_mask, 10, 8);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 10; ++x) {
+            EXPECT_EQ(fit.at(x, y, 0), x < 5 ? scene_mask.at(x, y, 0) : 0.0f) << x << "," << y;
+            if (x < 5) {
+                EXPECT_EQ(score.at(x, y, 0), 0.0f);
+            }
+        }
+    // The score mask is eroded 5x5 as cv2.erode (the image border does not erode): pixels within 2 of the
+    // hole are out, the others in.
+    EXPECT_EQ(score.at(7, 4, 0), 0.0f);
+    EXPECT_EQ(score.at(9, 2, 0), 0.0f);
+    EXPECT_EQ(score.at(5, 6, 0), 0.0f);
+    EXPECT_EQ(score.at(7, 1, 0), 1.0f);
+    EXPECT_EQ(score.at(9, 7, 0), 1.0f);
+    EXPECT_EQ(score.at(5, 0, 0), 1.0f);
+    // Without a scene mask: all ones, split the same way.
+    const Image none = holdout_fit_mask(Image{}, 10, 8);
+    EXPECT_EQ(none.at(4, 3, 0), 1.0f);
+    EXPECT_EQ(none.at(5, 3, 0), 0.0f);
+    EXPECT_THROW(holdout_fit_mask(Image(9, 8, 1, 1.0f), 10, 8), Error);
+}
+
+// The tiny scene, a short run on it, and a copy of the scene whose test photos are the run's renders.
+struct HoldoutScene {
+    TempDir dir{"eval_holdout"};
+    std::string scene = dir / "scene", run_dir = dir / "run", copy = dir / "copy";
+    bool ok = false;
+    ShCoeffs<double> light;
+    HoldoutScene() {
+        synth::generate_synthetic_scene(synth_test::tiny_options(scene));
+        if (run_lumigauss("train " + shell_quoted(scene) + " -o " + shell_quoted(run_dir) +
+                              " --preset fast --iterations 30 -q",
+                          dir)
+                .exit_code != 0)
+            return;
+        fs::copy(scene, copy, fs::copy_options::recursive);
+        const TrainedRun run = load_trained_run(run_dir);
+        light = run.learned_sh(1);
+        const Dataset d = load_dataset(copy, {});
+        for (const View* v : d.split(Split::Test)) write_png(v->image_path, render(run, v->camera, light));
+        ok = true;
+    }
+    static Image render(const TrainedRun& run, const Camera& cam, const ShCoeffs<double>& sh) {
+        const RasterImages<float> img =
+            render_with_environment(run.model, cam, sh.cast<float>(), ShadingMode::Shadowed);
+        Image out(cam.width, cam.height, 3);
+        for (std::size_t i = 0; i < out.pixels.size(); ++i)
+            out.pixels[i] = std::clamp(img.color[i], 0.0f, 1.0f);
+        return out;
+    }
+};
+
+const HoldoutScene& holdout_scene() {
+    static HoldoutScene s;
+    return s;
+}
+
+HoldoutOptions quick_options() {
+    HoldoutOptions o;
+    o.fit.variable = LightVariable::Sh;
+    o.fit.iterations = 150;
+    return o;
+}
+
+TEST(Holdout, TheFittedLightReproducesTheUnseenHalf) {
+    const HoldoutScene& s = holdout_scene();
+    ASSERT_TRUE(s.ok);
+    const TrainedRun run = load_trained_run(s.run_dir);
+    const Dataset d = load_dataset(s.copy, {});
+    const HoldoutResult r = evaluate_holdout(run, d, quick_options());
+    ASSERT_EQ(r.images.size(), d.split(Split::Test).size());
+    for (const HoldoutImageResult& im : r.images) {
+        EXPECT_GT(im.fit_pixels, 0u);
+        EXPECT_GT(im.score_pixels, 0u);
+        EXPECT_GT(im.fit_psnr, 35.0) << im.name;
+        EXPECT_GT(im.shadowed.psnr, 35.0) << im.name;
+        EXPECT_GT(im.shadowed.ssim, 0.95) << im.name;
+        EXPECT_EQ(im.panels.shadowed.width, im.panels.truth.width);
+    }
+    EXPECT_GT(r.mean_shadowed.psnr, 35.0);
+}
+
+TEST(Holdout, OnlyTheRightHalfIsScored) {
+    const HoldoutScene& s = holdout_scene();
+    ASSERT_TRUE(s.ok);
+    const TrainedRun run = load_trained_run(s.run_dir);
+    TempDir tmp("eval_holdout_changed");
+    const std::string changed = tmp / "scene";
+    fs::copy(s.copy, changed, fs::copy_options::recursive);
+    const Dataset d = load_dataset(changed, {});
+    const View& v = *d.split(Split::Test).front();
+    Image photo = read_image(v.image_path);
+    for (int y = 0; y < photo.height; ++y)
+        for (int x = photo.width / 2; x < photo.width; ++x)
+            for (int c = 0; c < photo.channels; ++c) photo.at(x, y, c) = 1.0f - photo.at(x, y, c);
+    write_png(v.image_path, photo);
+    const HoldoutResult r = evaluate_holdout(run, d, quick_options());
+    const HoldoutImageResult& im = r.images.front();
+    EXPECT_GT(im.fit_psnr, 35.0);       // the left half is untouched: fitted as well as before
+    EXPECT_LT(im.shadowed.psnr, 20.0);  // the right half is what is scored
+}
+
+}  // namespace
+}  // namespace lumigauss
