@@ -1,18 +1,28 @@
-// `lumigauss eval RUN --scene SCENE --protocol gt-env -o REPORT [-r N]`: evaluates a training run folder on
+// `lumigauss eval RUN --scene SCENE --protocol P -o REPORT [-r N]`: evaluates a training run folder on
 // the test photos of a scene and writes REPORT/metrics.json, REPORT/report.md and REPORT/sheets/*.png
-// (eval/report.h). Protocols: gt-env (eval/gt_env.h), for scenes that ship their true lighting.
+// (eval/report.h). Protocols: gt-env (eval/gt_env.h), for scenes that ship their true lighting; sol-nerf
+// (eval/sol_nerf.h), the paper's NeRF-OSR protocol with per-scene constants from a config file; holdout
+// (eval/holdout.h), for collections without ground-truth lighting: light fitted on the left half of each
+// photo, scored on the right half.
 #include <tbb/global_control.h>
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
+#include <numbers>
 #include <string>
+#include <vector>
 
 #include "commands.h"
 #include "lumigauss/eval/gt_env.h"
+#include "lumigauss/eval/holdout_report.h"
 #include "lumigauss/eval/report.h"
+#include "lumigauss/eval/sol_nerf.h"
+#include "lumigauss/eval/sol_nerf_report.h"
 #include "lumigauss/io/dataset.h"
+#include "lumigauss/train/trained_run.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss::cli {
@@ -23,13 +33,19 @@ struct EvalOptions {
     int downscale = 0;  // 0: the run's config.json downscale (1 if unknown)
     int threads = 0;
     bool no_sheets = false, quiet = false;
+    // sol-nerf
+    std::string sol_config, sol_scene, env_root, mask_root;
+    int angles = 0;  // 0: the config's
+    // holdout
+    std::string via = "auto";
+    int fit_iterations = 300;
 };
 
-void run_eval(const EvalOptions& o) {
-    std::unique_ptr<tbb::global_control> threads;
-    if (o.threads > 0)
-        threads =
-            std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, o.threads);
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void run_gt_env(const EvalOptions& o) {
     const auto t0 = std::chrono::steady_clock::now();
     // Check the scene's ground truth before the (slower) model load, so a wrong scene fails at once.
     const GtSceneMeta meta = load_gt_scene_meta(o.scene);
@@ -47,7 +63,7 @@ void run_eval(const EvalOptions& o) {
     gopt.keep_panels = !o.no_sheets;
     const GtEnvResult result = evaluate_gt_env(run, scene, meta, gopt);
     write_gt_env_report(o.out, result, {o.run, o.scene}, !o.no_sheets);
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double s = seconds_since(t0);
     if (!o.quiet) {
         std::printf("  light scale k = %.6g (fit on %zu training photos, relative residual %.3f)\n",
                     result.light.scale, result.light.per_photo.size(), result.light.relative_residual);
@@ -77,32 +93,203 @@ void run_eval(const EvalOptions& o) {
     std::printf("eval: wrote %s/metrics.json and %s/report.md (%.1f s)\n", o.out.c_str(), o.out.c_str(), s);
 }
 
+// Where a shipped configs/sol_nerf/NAME.json may be: beside the working folder, or up from the binary (build
+// trees put it in build/ or build/apps/, installs in bin/ next to share/).
+std::vector<std::string> shipped_config_dirs() {
+    namespace fs = std::filesystem;
+    std::vector<std::string> dirs{"configs/sol_nerf"};
+    std::error_code ec;
+    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (!ec)
+        for (const char* up : {"..", "../..", "../share/lumigauss"})
+            dirs.push_back((exe.parent_path() / up / "configs" / "sol_nerf").lexically_normal().string());
+    return dirs;
+}
+
+// --sol-config, else the shipped config of --sol-scene or of the scene the path names.
+std::string sol_config_path(const EvalOptions& o) {
+    if (!o.sol_config.empty()) return o.sol_config;
+    const std::string name = o.sol_scene.empty() ? guess_sol_nerf_scene(o.scene) : o.sol_scene;
+    if (name.empty())
+        throw Error(
+            "--protocol sol-nerf: give --sol-config FILE, or --sol-scene lk2|st|lwp for a shipped "
+            "config (the scene path " +
+            o.scene + " names none of them)");
+    const std::vector<std::string> dirs = shipped_config_dirs();
+    if (auto found = find_shipped_sol_nerf_config(name, dirs)) return *found;
+    const std::string file = name + ".json";
+    throw Error("--protocol sol-nerf: no shipped " + file + " in " + dirs.front() +
+                " or up from the binary; give --sol-config configs/sol_nerf/" + file);
+}
+
+void print_sol_nerf(const SolNerfResult& result) {
+    for (const SolNerfImageResult& im : result.images)
+        std::printf(
+            "  %-28s angle %7.2f deg%s  shadowed PSNR %6.2f SSIM %.4f | unshadowed PSNR %6.2f SSIM "
+            "%.4f\n",
+            im.config.name.c_str(), im.best_angle * 180.0 / std::numbers::pi,
+            im.best_at_range_edge() ? " (range end)" : "", im.shadowed.psnr, im.shadowed.ssim,
+            im.unshadowed.psnr, im.unshadowed.ssim);
+    std::printf("  mean: shadowed PSNR %.2f SSIM %.4f MSE %.5f MAE %.4f | unshadowed PSNR %.2f SSIM %.4f\n",
+                result.mean_shadowed.psnr, result.mean_shadowed.ssim, result.mean_shadowed.mse,
+                result.mean_shadowed.mae, result.mean_unshadowed.psnr, result.mean_unshadowed.ssim);
+}
+
+void run_sol_nerf(const EvalOptions& o) {
+    const auto t0 = std::chrono::steady_clock::now();
+    // Check the config before the (slower) model load, so a wrong config fails at once.
+    const SolNerfConfig config = load_sol_nerf_config(sol_config_path(o));
+    const TrainedRun run = load_run_or_ply(o.run);
+    DatasetOptions dopt;
+    dopt.downscale = o.downscale > 0 ? o.downscale : (run.downscale > 0 ? run.downscale : 1);
+    const Dataset scene = load_dataset(o.scene, dopt);
+    if (!o.quiet)
+        std::printf("eval: %zu surfels from %s; %zu test images of %s at 1/%d, config %s, %d angles each\n",
+                    run.model.size(), o.run.c_str(), config.images.size(), o.scene.c_str(), dopt.downscale,
+                    config.path.c_str(), o.angles > 0 ? o.angles : config.angles);
+    SolNerfOptions sopt;
+    sopt.keep_panels = !o.no_sheets;
+    sopt.angles = o.angles;
+    sopt.roots = {o.scene, o.env_root, o.mask_root};
+    const SolNerfResult result = evaluate_sol_nerf(run.model, scene, config, sopt);
+    write_sol_nerf_report(o.out, result, {o.run, o.scene}, !o.no_sheets);
+    if (!o.quiet) print_sol_nerf(result);
+    // The gt-env summary keys (albedo and normals: nan, NeRF-OSR has no such ground truth), then MSE/MAE.
+    std::printf(
+        "eval-summary: shadowed_psnr=%.4f shadowed_ssim=%.4f unshadowed_psnr=%.4f unshadowed_ssim=%.4f "
+        "albedo_psnr=nan normal_mean_deg=nan normal_median_deg=nan render_ms=%.2f shadowed_mse=%.6f "
+        "shadowed_mae=%.6f unshadowed_mse=%.6f unshadowed_mae=%.6f search_s=%.2f\n",
+        result.mean_shadowed.psnr, result.mean_shadowed.ssim, result.mean_unshadowed.psnr,
+        result.mean_unshadowed.ssim, result.median_render_ms, result.mean_shadowed.mse,
+        result.mean_shadowed.mae, result.mean_unshadowed.mse, result.mean_unshadowed.mae,
+        result.search_seconds);
+    std::printf("eval: wrote %s/metrics.json and %s/report.md (%.1f s)\n", o.out.c_str(), o.out.c_str(),
+                seconds_since(t0));
+}
+
+void run_holdout(const EvalOptions& o) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const TrainedRun run = load_run_or_ply(o.run);
+    DatasetOptions dopt;
+    dopt.downscale = o.downscale > 0 ? o.downscale : (run.downscale > 0 ? run.downscale : 1);
+    const Dataset scene = load_dataset(o.scene, dopt);
+    HoldoutOptions hopt;
+    hopt.views = o.views == "train" ? Split::Train : Split::Test;
+    hopt.keep_panels = !o.no_sheets;
+    const bool has_network = run.lighting.num_images() > 0;
+    hopt.fit.variable =
+        o.via == "sh" || (o.via == "auto" && !has_network) ? LightVariable::Sh : LightVariable::Embedding;
+    hopt.fit.iterations = o.fit_iterations;
+    if (!o.quiet)
+        std::printf(
+            "eval: %zu surfels from %s; %zu %s views of %s at 1/%d; light fitted on the left half "
+            "via the %s (%d iterations), scored on the right half\n",
+            run.model.size(), o.run.c_str(), scene.split(hopt.views).size(), o.views.c_str(), o.scene.c_str(),
+            dopt.downscale, light_variable_name(hopt.fit.variable), hopt.fit.iterations);
+    const HoldoutResult result = evaluate_holdout(run, scene, hopt);
+    write_holdout_report(o.out, result, {o.run, o.scene}, dopt.downscale, !o.no_sheets);
+    if (!o.quiet) {
+        for (const HoldoutImageResult& im : result.images)
+            std::printf(
+                "  %-28s fit PSNR %6.2f | shadowed PSNR %6.2f SSIM %.4f | unshadowed PSNR %6.2f SSIM "
+                "%.4f\n",
+                im.name.c_str(), im.fit_psnr, im.shadowed.psnr, im.shadowed.ssim, im.unshadowed.psnr,
+                im.unshadowed.ssim);
+        std::printf("  mean: shadowed PSNR %.2f SSIM %.4f | unshadowed PSNR %.2f SSIM %.4f (fit %.2f dB)\n",
+                    result.mean_shadowed.psnr, result.mean_shadowed.ssim, result.mean_unshadowed.psnr,
+                    result.mean_unshadowed.ssim, result.mean_fit_psnr);
+    }
+    std::printf(
+        "eval-summary: shadowed_psnr=%.4f shadowed_ssim=%.4f unshadowed_psnr=%.4f unshadowed_ssim=%.4f "
+        "albedo_psnr=nan normal_mean_deg=nan normal_median_deg=nan render_ms=%.2f fit_psnr=%.4f "
+        "fit_ms=%.1f\n",
+        result.mean_shadowed.psnr, result.mean_shadowed.ssim, result.mean_unshadowed.psnr,
+        result.mean_unshadowed.ssim, result.median_render_ms, result.mean_fit_psnr, result.median_fit_ms);
+    std::printf("eval: wrote %s/metrics.json and %s/report.md (%.1f s)\n", o.out.c_str(), o.out.c_str(),
+                seconds_since(t0));
+}
+
+void run_eval(const EvalOptions& o) {
+    std::unique_ptr<tbb::global_control> threads;
+    if (o.threads > 0)
+        threads =
+            std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, o.threads);
+    if (o.protocol == "sol-nerf")
+        run_sol_nerf(o);
+    else if (o.protocol == "holdout")
+        run_holdout(o);
+    else
+        run_gt_env(o);
+}
+
 }  // namespace
 
 void register_eval(CLI::App& app) {
     auto o = std::make_shared<EvalOptions>();
     CLI::App* cmd = app.add_subcommand("eval", "Evaluate a training run on the test photos of a scene");
-    cmd->add_option("run", o->run, "training run folder (model.ply, lighting.lgmlp, appearance.json)")
+    cmd->add_option("run", o->run,
+                    "training run folder (model.ply, lighting.lgmlp, appearance.json); sol-nerf also takes a "
+                    "bare relightable PLY (the official LumiGauss layout)")
         ->required();
-    cmd->add_option("--scene", o->scene, "scene folder with ground truth (meta.json, env/COND_sh.txt, gt/)")
+    cmd->add_option(
+           "--scene", o->scene,
+           "the scene: for gt-env with ground truth (meta.json, env/COND_sh.txt, gt/); for sol-nerf a "
+           "NeRF-OSR scene (COLMAP layout as on Zenodo, or NeRF-OSR's final/ layout)")
         ->required();
     cmd->add_option("--protocol", o->protocol,
                     "gt-env: render each test photo under its true environment SH, scaled by the one "
-                    "light scale fitted on the training photos")
-        ->check(CLI::IsMember({"gt-env"}))
+                    "light scale fitted on the training photos; sol-nerf: the paper's NeRF-OSR protocol "
+                    "(ground-truth panorama -> fake HDR -> SH -> fixed rotation -> best of N y-angles by "
+                    "shadowed masked PSNR on the photo); holdout: for photos without ground-truth lighting, "
+                    "fit each photo's light on its left half (fit-light) and score its right half")
+        ->check(CLI::IsMember({"gt-env", "sol-nerf", "holdout"}))
         ->capture_default_str();
     cmd->add_option("-o,--output", o->out, "report folder")->capture_default_str();
     cmd->add_option("-r,--downscale", o->downscale,
                     "evaluate at 1/1, 1/2, 1/4 or 1/8 resolution (default: the run's training resolution)")
         ->check(CLI::IsMember({0, 1, 2, 4, 8}));
-    cmd->add_option("--views", o->views,
-                    "test: the protocol (novel views, novel lights); train: diagnostic, the training views "
-                    "under their own true lights (separates lighting from novel-view geometry)")
+    cmd->add_option(
+           "--views", o->views,
+           "gt-env and holdout. test: the protocol (novel views, novel lights); train: diagnostic, the "
+           "training views (gt-env: under their own true lights; separates lighting from novel-view "
+           "geometry)")
         ->check(CLI::IsMember({"test", "train"}))
         ->capture_default_str();
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)");
     cmd->add_flag("--no-sheets", o->no_sheets, "skip the contact sheets");
     cmd->add_flag("-q,--quiet", o->quiet, "print only the final line");
+    const std::string sol = "sol-nerf";
+    cmd->add_option("--sol-config", o->sol_config,
+                    "the per-scene constants (test images, env maps, masks, rotations, HDR boost, y-ranges), "
+                    "JSON as configs/sol_nerf/README.md; default: the shipped config of --sol-scene")
+        ->group(sol);
+    cmd->add_option("--sol-scene", o->sol_scene,
+                    "use the shipped configs/sol_nerf/NAME.json (default: lk2, st or lwp when the scene path "
+                    "names one, e.g. data/lk2_colmap/undistorted)")
+        ->check(CLI::IsMember({"lk2", "st", "lwp"}))
+        ->group(sol);
+    cmd->add_option("--env-root", o->env_root,
+                    "folder the config's relative env_map paths start from, i.e. the one holding ENV_MAP_CC/ "
+                    "(default: the scene folder, then its final/)")
+        ->group(sol);
+    cmd->add_option("--mask-root", o->mask_root,
+                    "folder the config's relative mask paths start from (the NeRF-OSR evaluation masks; "
+                    "default: the scene folder, then its final/)")
+        ->group(sol);
+    cmd->add_option("--angles", o->angles, "y-angles searched per image (default: the config's, 51)")
+        ->check(CLI::PositiveNumber)
+        ->group(sol);
+    const std::string holdout = "holdout";
+    cmd->add_option("--via", o->via,
+                    "what fit-light optimises: sh, embedding (through the run's lighting network), auto "
+                    "(embedding when the run has a network)")
+        ->check(CLI::IsMember({"auto", "sh", "embedding"}))
+        ->capture_default_str()
+        ->group(holdout);
+    cmd->add_option("--fit-iterations", o->fit_iterations, "Adam iterations of each fit")
+        ->check(CLI::Range(1, 100000))
+        ->capture_default_str()
+        ->group(holdout);
     cmd->callback([o] { run_eval(*o); });
 }
 

@@ -4,6 +4,7 @@
 
 namespace lumigauss::cli {
 
+void register_env(CLI::App& app);
 void register_eval(CLI::App& app);
 void register_export(CLI::App& app);
 void register_fit_light(CLI::App& app);

@@ -9,6 +9,7 @@ int main(int argc, char** argv) {
     CLI::App app{"lumigauss: relightable 2D Gaussian surfels from photos under many lightings"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "lumigauss 0.1.0");
+    lumigauss::cli::register_env(app);
     lumigauss::cli::register_eval(app);
     lumigauss::cli::register_export(app);
     lumigauss::cli::register_fit_light(app);

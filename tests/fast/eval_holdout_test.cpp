@@ -132,5 +132,33 @@ TEST(Holdout, OnlyTheRightHalfIsScored) {
     EXPECT_LT(im.shadowed.psnr, 20.0);  // the right half is what is scored
 }
 
+TEST(Holdout, CliWritesTheReport) {
+    const HoldoutScene& s = holdout_scene();
+    ASSERT_TRUE(s.ok);
+    TempDir tmp("eval_holdout_cli");
+    const std::string report = tmp / "report";
+    const testing::CommandResult r =
+        run_lumigauss("eval " + shell_quoted(s.run_dir) + " --scene " + shell_quoted(s.copy) +
+                          " --protocol holdout --via sh --fit-iterations 100 -o " + shell_quoted(report),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("eval-summary: shadowed_psnr="), std::string::npos) << r.output;
+    const nlohmann::json m = synth_test::read_json(report + "/metrics.json");
+    EXPECT_EQ(m["protocol"], "holdout");
+    EXPECT_EQ(m["fit"]["variable"], "sh");
+    EXPECT_EQ(m["fit"]["iterations"], 100);
+    const Dataset d = load_dataset(s.copy, {});
+    const std::vector<const View*> tests = d.split(Split::Test);
+    ASSERT_EQ(m["images"].size(), tests.size());
+    EXPECT_GT(m["mean"]["shadowed"]["psnr"].get<double>(), 30.0);
+    for (const View* v : tests) {
+        fs::path stem = fs::path(v->name);
+        stem.replace_extension();
+        EXPECT_TRUE(fs::exists(report + "/sheets/" + stem.string() + ".png")) << v->name;
+        EXPECT_TRUE(fs::exists(report + "/env/" + stem.string() + "_sh.txt")) << v->name;
+    }
+    EXPECT_TRUE(fs::exists(report + "/report.md"));
+}
+
 }  // namespace
 }  // namespace lumigauss

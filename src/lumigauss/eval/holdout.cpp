@@ -50,19 +50,19 @@ HoldoutImageResult evaluate_view(const TrainedRun& run, const Dataset& scene, co
     HoldoutImageResult r;
     r.name = view.name;
     const int w = view.camera.width, h = view.camera.height;
-    HoldoutPanels& p = r.panels;
+    GtEnvPanels& p = r.panels;
     p.truth = scene.load_image(view);
     const Image scene_mask = scene.load_mask(view);
-    p.fit_mask = holdout_fit_mask(scene_mask, w, h);
-    p.score_mask = holdout_score_mask(scene_mask, w, h);
-    r.fit_pixels = mask_pixels(p.fit_mask);
-    r.score_pixels = mask_pixels(p.score_mask);
+    const Image fit_mask = holdout_fit_mask(scene_mask, w, h);
+    p.mask = holdout_score_mask(scene_mask, w, h);
+    r.fit_pixels = mask_pixels(fit_mask);
+    r.score_pixels = mask_pixels(p.mask);
     if (r.fit_pixels == 0) throw Error(view.image_path + ": holdout: the left half has no pixel to fit");
     if (r.score_pixels == 0)
         throw Error(view.image_path + ": holdout: the right half has no fully covered pixel to score");
 
     auto t0 = Clock::now();
-    const LightFitResult fit = fit_light(run, view.camera, p.truth, p.fit_mask, options.fit);
+    const LightFitResult fit = fit_light(run, view.camera, p.truth, fit_mask, options.fit);
     r.fit_ms = ms_since(t0);
     r.fit_psnr = fit.final_psnr;
     r.light = fit.sh;
@@ -72,15 +72,15 @@ HoldoutImageResult evaluate_view(const TrainedRun& run, const Dataset& scene, co
     r.render_ms = ms_since(t0);
     p.shadowed = clamp01(raster_channels(relit, kRelitShadowed, 3));
     p.unshadowed = clamp01(raster_channels(relit, kRelitUnshadowed, 3));
-    r.shadowed = image_metrics(p.shadowed, p.truth, p.score_mask, options.ssim);
-    r.unshadowed = image_metrics(p.unshadowed, p.truth, p.score_mask, options.ssim);
+    r.shadowed = image_metrics(p.shadowed, p.truth, p.mask, options.ssim);
+    r.unshadowed = image_metrics(p.unshadowed, p.truth, p.mask, options.ssim);
     if (options.keep_panels) {
         p.albedo = clamp01(raster_channels(relit, kRelitAlbedo, 3));
         p.normal = encode_normals(relit);
         p.shadow = shadow_image(raster_channels(relit, kRelitIntensityUnshadowed, 3),
                                 raster_channels(relit, kRelitIntensityShadowed, 3));
     } else {
-        p = HoldoutPanels{};
+        p = GtEnvPanels{};
     }
     return r;
 }

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "lumigauss/eval/gt_env.h"
 #include "lumigauss/eval/metrics.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
@@ -29,14 +30,6 @@ struct HoldoutOptions {
     bool keep_panels = true;
 };
 
-// What the contact sheet shows (3 channels unless noted), at the evaluated resolution.
-struct HoldoutPanels {
-    Image truth, shadowed, unshadowed;  // photo and clamped renders under the fitted light
-    Image albedo, normal;               // model albedo (clamped) and normals encoded (n + 1)/2
-    Image shadow;                       // 1 channel: the paper's shadow image, 1 = lit
-    Image fit_mask, score_mask;         // 1 channel each
-};
-
 struct HoldoutImageResult {
     std::string name;
     std::size_t fit_pixels = 0, score_pixels = 0;
@@ -44,7 +37,9 @@ struct HoldoutImageResult {
     double fit_ms = 0, render_ms = 0;
     ShCoeffs<double> light;             // the fitted environment SH
     ImageMetrics shadowed, unshadowed;  // on the right half
-    HoldoutPanels panels;
+    // The contact sheet's panels (report.h's SheetPanels): photo, clamped renders under the fitted light,
+    // albedo (clamped), normals, shadow image, and as `mask` the score mask. No ground-truth panels.
+    GtEnvPanels panels;
 };
 
 struct HoldoutResult {

@@ -6,6 +6,7 @@
 
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/io/image.h"
+#include "lumigauss/shading/sh_text.h"
 
 namespace lumigauss {
 namespace {
@@ -15,11 +16,6 @@ using Json = nlohmann::ordered_json;
 
 Json number(double v) {
     return std::isfinite(v) ? Json(v) : Json(nullptr);
-}
-
-Json metrics_json(const ImageMetrics& m) {
-    return Json{
-        {"psnr", number(m.psnr)}, {"ssim", number(m.ssim)}, {"mse", number(m.mse)}, {"mae", number(m.mae)}};
 }
 
 Json albedo_json(const AlbedoMetrics& m) {
@@ -43,13 +39,6 @@ std::string fmt(const char* f, double v) {
     return buf;
 }
 
-// The sheet file of an image: sheets/<name without extension>.png (folders in the name kept).
-std::string sheet_relative_path(const std::string& image_name) {
-    fs::path p = fs::path("sheets") / image_name;
-    p.replace_extension(".png");
-    return p.generic_string();
-}
-
 void paste(Image& sheet, const Image& panel, int x0, int y0, int w, int h, double gain = 1.0) {
     if (panel.empty() || panel.width != w || panel.height != h) return;  // left black
     for (int y = 0; y < h; ++y)
@@ -68,6 +57,104 @@ Image abs_difference(const Image& a, const Image& b) {
 }
 
 }  // namespace
+
+// ---- Shared by the protocols -----------------------------------------------------------------------------
+
+std::string sheet_relative_path(const std::string& image_name) {
+    fs::path p = fs::path("sheets") / image_name;
+    p.replace_extension(".png");
+    return p.generic_string();
+}
+
+std::string sh_file_relative_path(const std::string& image_name) {
+    fs::path p = fs::path("env") / image_name;
+    p.replace_extension();
+    return p.generic_string() + "_sh.txt";
+}
+
+void write_scored_lights(const std::string& dir,
+                         const std::vector<std::pair<std::string, ShCoeffs<double>>>& lights) {
+    for (const auto& [name, sh] : lights) {
+        const fs::path path = fs::path(dir) / sh_file_relative_path(name);
+        fs::create_directories(path.parent_path());
+        write_sh_text(path.string(), sh);
+    }
+}
+
+nlohmann::ordered_json sh_coeffs_json(const ShCoeffs<double>& sh) {
+    nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+    for (const Vec3d& c : sh.c)
+        rows.push_back(nlohmann::ordered_json::array({json_number(c.x), json_number(c.y), json_number(c.z)}));
+    return rows;
+}
+
+Image contact_sheet(const SheetPanels& p) {
+    const int w = p.truth.width, h = p.truth.height, gap = 2;
+    Image sheet(6 * w + 5 * gap, 2 * h + gap, 3, 1.0f);
+    const Image* top[6] = {&p.truth, &p.shadowed, &p.unshadowed, &p.albedo, &p.normal, &p.shadow};
+    const Image err_s = abs_difference(p.shadowed, p.truth), err_u = abs_difference(p.unshadowed, p.truth);
+    const Image* bottom[6] = {&p.mask, &err_s, &err_u, &p.gt_albedo, &p.gt_normal, &p.normal_error};
+    const double gains[6] = {1, 4, 4, 1, 1, 1};
+    for (int i = 0; i < 6; ++i) {
+        const int x0 = i * (w + gap);
+        for (int row = 0; row < 2; ++row)
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x)
+                    for (int c = 0; c < 3; ++c) sheet.at(x0 + x, row * (h + gap) + y, c) = 0.0f;
+        paste(sheet, *top[i], x0, 0, w, h);
+        paste(sheet, *bottom[i], x0, h + gap, w, h, gains[i]);
+    }
+    return sheet;
+}
+
+nlohmann::ordered_json json_number(double v) {
+    return number(v);
+}
+
+nlohmann::ordered_json image_metrics_json(const ImageMetrics& m) {
+    return Json{
+        {"psnr", number(m.psnr)}, {"ssim", number(m.ssim)}, {"mse", number(m.mse)}, {"mae", number(m.mae)}};
+}
+
+std::string format_number(const char* printf_format, double v) {
+    return fmt(printf_format, v);
+}
+
+std::string metrics_table_markdown(const std::vector<std::pair<std::string, ImageMetrics>>& rows) {
+    std::string s = "| | PSNR | SSIM | MSE | MAE |\n| --- | --- | --- | --- | --- |\n";
+    for (const auto& [label, m] : rows)
+        s += "| " + label + " | " + fmt("%.2f", m.psnr) + " | " + fmt("%.4f", m.ssim) + " | " +
+             fmt("%.5f", m.mse) + " | " + fmt("%.4f", m.mae) + " |\n";
+    return s;
+}
+
+std::string contact_sheets_markdown(const std::vector<std::string>& names, const std::string& caption) {
+    std::string s = "\n## Contact sheets\n\n" + caption + "\n\n";
+    for (const std::string& name : names)
+        s += "### " + name + "\n\n![" + name + "](" + sheet_relative_path(name) + ")\n\n";
+    return s;
+}
+
+bool write_contact_sheets(const std::string& dir, const std::vector<SheetEntry>& entries, bool with_sheets) {
+    bool sheets = with_sheets && !entries.empty();
+    for (const SheetEntry& e : entries) sheets = sheets && e.panels && !e.panels->truth.empty();
+    if (!sheets) return false;
+    for (const SheetEntry& e : entries) {
+        const fs::path path = fs::path(dir) / sheet_relative_path(e.name);
+        fs::create_directories(path.parent_path());
+        write_png(path.string(), contact_sheet(*e.panels));
+    }
+    return true;
+}
+
+void write_report_files(const std::string& dir, const nlohmann::ordered_json& metrics,
+                        const std::string& markdown) {
+    fs::create_directories(dir);
+    write_file_atomically((fs::path(dir) / "metrics.json").string(), metrics.dump(2) + "\n");
+    write_file_atomically((fs::path(dir) / "report.md").string(), markdown);
+}
+
+// ---- gt-env -----------------------------------------------------------------------------------------------
 
 nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSources& src) {
     Json j;
@@ -102,8 +189,8 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
         e["exposure"] = im.exposure;
         e["mask_pixels"] = im.mask_pixels;
         e["render_ms"] = im.render_ms;
-        e["shadowed"] = metrics_json(im.shadowed);
-        e["unshadowed"] = metrics_json(im.unshadowed);
+        e["shadowed"] = image_metrics_json(im.shadowed);
+        e["unshadowed"] = image_metrics_json(im.unshadowed);
         if (im.has_albedo)
             e["albedo"] = albedo_json(im.albedo), e["albedo_gamma"] = albedo_json(im.albedo_gamma);
         if (im.has_normal) e["normal"] = normal_json(im.normal);
@@ -111,8 +198,8 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
     }
     j["images"] = images;
     Json mean;
-    mean["shadowed"] = metrics_json(r.mean_shadowed);
-    mean["unshadowed"] = metrics_json(r.mean_unshadowed);
+    mean["shadowed"] = image_metrics_json(r.mean_shadowed);
+    mean["unshadowed"] = image_metrics_json(r.mean_unshadowed);
     if (r.has_albedo)
         mean["albedo"] = albedo_json(r.mean_albedo), mean["albedo_gamma"] = albedo_json(r.mean_albedo_gamma);
     if (r.has_normal) mean["normal"] = normal_json(r.mean_normal, false);
@@ -166,12 +253,7 @@ std::string gt_env_report_markdown(const GtEnvResult& r, const ReportSources& sr
              "counts "
              "as 90 deg.\n";
     s += "\n## Summary (mean over test images)\n\n";
-    s += "| | PSNR | SSIM | MSE | MAE |\n| --- | --- | --- | --- | --- |\n";
-    auto row = [](const std::string& label, const ImageMetrics& m) {
-        return "| " + label + " | " + fmt("%.2f", m.psnr) + " | " + fmt("%.4f", m.ssim) + " | " +
-               fmt("%.5f", m.mse) + " | " + fmt("%.4f", m.mae) + " |\n";
-    };
-    s += row("shadowed", r.mean_shadowed) + row("unshadowed", r.mean_unshadowed);
+    s += metrics_table_markdown({{"shadowed", r.mean_shadowed}, {"unshadowed", r.mean_unshadowed}});
     if (r.has_albedo) {
         s += "| albedo (linear) | " + fmt("%.2f", r.mean_albedo.psnr) + " | | " +
              fmt("%.5f", r.mean_albedo.mse) + " | " + fmt("%.4f", r.mean_albedo.mae) + " |\n";
@@ -195,50 +277,28 @@ std::string gt_env_report_markdown(const GtEnvResult& r, const ReportSources& sr
                             : "n/a") +
              " |\n";
     if (with_sheets) {
-        s += "\n## Contact sheets\n\nTop: photo | shadowed | unshadowed | albedo | normals | shadow "
-             "(shadowed / unshadowed). Bottom: mask | shadowed error x4 | unshadowed error x4 | ground-truth "
-             "albedo | ground-truth normals | normal error (white = 45 deg or more).\n\n";
-        for (const GtEnvImageResult& im : r.images)
-            s += "### " + im.name + "\n\n![" + im.name + "](" + sheet_relative_path(im.name) + ")\n\n";
+        std::vector<std::string> names;
+        for (const GtEnvImageResult& im : r.images) names.push_back(im.name);
+        s += contact_sheets_markdown(names,
+                                     "Top: photo | shadowed | unshadowed | albedo | normals | shadow "
+                                     "(shadowed / unshadowed). Bottom: mask | shadowed error x4 | unshadowed "
+                                     "error x4 | ground-truth albedo | ground-truth normals | normal error "
+                                     "(white = 45 deg or more).");
     }
     return s;
 }
 
 Image gt_env_contact_sheet(const GtEnvImageResult& im) {
-    const GtEnvPanels& p = im.panels;
-    const int w = p.truth.width, h = p.truth.height, gap = 2;
-    Image sheet(6 * w + 5 * gap, 2 * h + gap, 3, 1.0f);
-    const Image* top[6] = {&p.truth, &p.shadowed, &p.unshadowed, &p.albedo, &p.normal, &p.shadow};
-    const Image err_s = abs_difference(p.shadowed, p.truth), err_u = abs_difference(p.unshadowed, p.truth);
-    const Image* bottom[6] = {&p.mask, &err_s, &err_u, &p.gt_albedo, &p.gt_normal, &p.normal_error};
-    const double gains[6] = {1, 4, 4, 1, 1, 1};
-    for (int i = 0; i < 6; ++i) {
-        const int x0 = i * (w + gap);
-        for (int row = 0; row < 2; ++row)
-            for (int y = 0; y < h; ++y)
-                for (int x = 0; x < w; ++x)
-                    for (int c = 0; c < 3; ++c) sheet.at(x0 + x, row * (h + gap) + y, c) = 0.0f;
-        paste(sheet, *top[i], x0, 0, w, h);
-        paste(sheet, *bottom[i], x0, h + gap, w, h, gains[i]);
-    }
-    return sheet;
+    return contact_sheet(im.panels);
 }
 
 void write_gt_env_report(const std::string& dir, const GtEnvResult& result, const ReportSources& sources,
                          bool with_sheets) {
-    fs::create_directories(dir);
-    bool sheets = with_sheets && !result.images.empty();
-    for (const GtEnvImageResult& im : result.images) sheets = sheets && !im.panels.truth.empty();
-    if (sheets)
-        for (const GtEnvImageResult& im : result.images) {
-            const fs::path path = fs::path(dir) / sheet_relative_path(im.name);
-            fs::create_directories(path.parent_path());
-            write_png(path.string(), gt_env_contact_sheet(im));
-        }
-    write_file_atomically((fs::path(dir) / "metrics.json").string(),
-                          gt_env_metrics_json(result, sources).dump(2) + "\n");
-    write_file_atomically((fs::path(dir) / "report.md").string(),
-                          gt_env_report_markdown(result, sources, sheets));
+    std::vector<SheetEntry> entries;
+    for (const GtEnvImageResult& im : result.images) entries.push_back({im.name, &im.panels});
+    const bool sheets = write_contact_sheets(dir, entries, with_sheets);
+    write_report_files(dir, gt_env_metrics_json(result, sources),
+                       gt_env_report_markdown(result, sources, sheets));
 }
 
 }  // namespace lumigauss

@@ -19,8 +19,13 @@
 //    "mean": {"shadowed", "unshadowed", "albedo", "albedo_gamma", "normal"},
 //    "normal_all_pixels": {"mean_deg", "median_deg", "pixels", "missing"}}
 // Non-finite numbers are written as null.
+// Other protocols (sol-nerf: eval/sol_nerf_report.h) write the same three kinds of files with the shared
+// pieces below: the contact sheet of any per-image SheetPanels (the panels a protocol has no ground truth for
+// stay black), the metrics table and JSON of ImageMetrics, and the atomic writers.
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "lumigauss/eval/gt_env.h"
 
@@ -30,10 +35,52 @@ struct ReportSources {
     std::string run, scene;
 };
 
+// ---- Shared by the protocols -----------------------------------------------------------------------------
+
+// The panels of one contact sheet (layout above), whichever protocol fills them.
+using SheetPanels = GtEnvPanels;
+
+// sheets/<image name without extension>.png (folders in the name kept), relative to the report folder.
+std::string sheet_relative_path(const std::string& image_name);
+// The two-row contact sheet (3 channels; empty panels are drawn black; 1-channel panels grey).
+Image contact_sheet(const SheetPanels& panels);
+
+// env/<image name without extension>_sh.txt, relative to the report folder: the light an image was scored
+// under, as an SH text file (`lumigauss render --light`).
+std::string sh_file_relative_path(const std::string& image_name);
+// Writes each (image name, SH) pair to dir/sh_file_relative_path(name).
+void write_scored_lights(const std::string& dir,
+                         const std::vector<std::pair<std::string, ShCoeffs<double>>>& lights);
+// [[r, g, b] x 9], coefficient order of shading/sh.h.
+nlohmann::ordered_json sh_coeffs_json(const ShCoeffs<double>& sh);
+// A number for metrics.json: null when not finite.
+nlohmann::ordered_json json_number(double v);
+// {"psnr", "ssim", "mse", "mae"}.
+nlohmann::ordered_json image_metrics_json(const ImageMetrics& m);
+// printf-formatted, "n/a" when not finite.
+std::string format_number(const char* printf_format, double v);
+// "| | PSNR | SSIM | MSE | MAE |" and one row per (label, metrics), PSNR %.2f, SSIM %.4f, MSE %.5f, MAE %.4f.
+std::string metrics_table_markdown(const std::vector<std::pair<std::string, ImageMetrics>>& rows);
+// The "## Contact sheets" section: `caption`, then each image's name and its sheet.
+std::string contact_sheets_markdown(const std::vector<std::string>& names, const std::string& caption);
+
+struct SheetEntry {
+    std::string name;  // the image name (gives the sheet's file name)
+    const SheetPanels* panels = nullptr;
+};
+// Writes every entry's sheet into `dir` when with_sheets and every entry has its panels (a photo); returns
+// whether the sheets were written (report.md links them only then).
+bool write_contact_sheets(const std::string& dir, const std::vector<SheetEntry>& entries, bool with_sheets);
+// Creates `dir`, writes metrics.json (indented by 2, newline-terminated) and report.md, each atomically.
+void write_report_files(const std::string& dir, const nlohmann::ordered_json& metrics,
+                        const std::string& markdown);
+
+// ---- gt-env -----------------------------------------------------------------------------------------------
+
 nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& result, const ReportSources& sources);
 std::string gt_env_report_markdown(const GtEnvResult& result, const ReportSources& sources, bool with_sheets);
 
-// The two-row contact sheet of one image (3 channels; empty panels are drawn black; 1-channel panels grey).
+// contact_sheet of the image's panels.
 Image gt_env_contact_sheet(const GtEnvImageResult& image);
 
 // Writes metrics.json, report.md and (if with_sheets and the panels were kept) sheets/*.png into `dir`,

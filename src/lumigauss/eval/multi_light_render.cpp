@@ -1,0 +1,50 @@
+#include "lumigauss/eval/multi_light_render.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+#include "lumigauss/render/raster_maps.h"
+#include "lumigauss/shading/surfel_shading.h"
+
+namespace lumigauss {
+
+MultiLightRenderer::MultiLightRenderer(const GaussianModel& model) : model_(model) {}
+
+void MultiLightRenderer::shade_pass(std::span<const ShCoeffs<float>> envs) {
+    const std::size_t n = model_.size(), ch = 3 * envs.size();
+    const auto& albedo = model_.param(ModelParam::Albedo);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
+        float pos[kTransferCoeffs], neg[kTransferCoeffs];
+        for (std::size_t i = r.begin(); i < r.end(); ++i) {
+            model_.transfer_channel0(true, i, pos);
+            model_.transfer_channel0(false, i, neg);
+            const Vec3f raw{albedo[3 * i], albedo[3 * i + 1], albedo[3 * i + 2]};
+            const bool positive = normals_.positive_side[i] != 0;
+            for (std::size_t k = 0; k < envs.size(); ++k) {
+                const Vec3f rgb = surfel_colour_shadowed(envs[k], raw, pos, neg, positive);
+                for (int c = 0; c < 3; ++c) batch_.colors[i * ch + 3 * k + std::size_t(c)] = rgb[c];
+            }
+        }
+    });
+}
+
+std::vector<Image> MultiLightRenderer::render_shadowed(const Camera& camera,
+                                                       std::span<const ShCoeffs<float>> envs) {
+    compute_view_normals(model_, camera, normals_);
+    std::vector<Image> out;
+    out.reserve(envs.size());
+    for (std::size_t first = 0; first < envs.size(); first += kLightsPerPass) {
+        const std::span<const ShCoeffs<float>> pass =
+            envs.subspan(first, std::min<std::size_t>(kLightsPerPass, envs.size() - first));
+        batch_.channels = int(3 * pass.size());
+        model_.activated(batch_);  // geometry, and colours resized to this pass's channel count
+        shade_pass(pass);
+        rasterize_forward_cpu(camera, batch_, RasterSettings<float>{}, state_, images_);
+        for (std::size_t k = 0; k < pass.size(); ++k) out.push_back(raster_channels(images_, int(3 * k), 3));
+    }
+    return out;
+}
+
+}  // namespace lumigauss
