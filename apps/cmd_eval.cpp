@@ -191,10 +191,10 @@ void run_holdout(const EvalOptions& o) {
     if (!o.quiet) {
         for (const HoldoutImageResult& im : result.images)
             std::printf(
-                "  %-28s fit PSNR %6.2f | shadowed PSNR %6.2f SSIM %.4f | unshadowed PSNR %6.2f SSIM "
+                "  %-28s fit PSNR %6.2f/%6.2f | shadowed PSNR %6.2f SSIM %.4f | unshadowed PSNR %6.2f SSIM "
                 "%.4f\n",
-                im.name.c_str(), im.fit_psnr, im.shadowed.psnr, im.shadowed.ssim, im.unshadowed.psnr,
-                im.unshadowed.ssim);
+                im.name.c_str(), im.fit_psnr, im.fit_psnr_unshadowed, im.shadowed.psnr, im.shadowed.ssim,
+                im.unshadowed.psnr, im.unshadowed.ssim);
         std::printf("  mean: shadowed PSNR %.2f SSIM %.4f | unshadowed PSNR %.2f SSIM %.4f (fit %.2f dB)\n",
                     result.mean_shadowed.psnr, result.mean_shadowed.ssim, result.mean_unshadowed.psnr,
                     result.mean_unshadowed.ssim, result.mean_fit_psnr);

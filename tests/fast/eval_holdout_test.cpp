@@ -105,6 +105,7 @@ TEST(Holdout, TheFittedLightReproducesTheUnseenHalf) {
         EXPECT_GT(im.fit_pixels, 0u);
         EXPECT_GT(im.score_pixels, 0u);
         EXPECT_GT(im.fit_psnr, 35.0) << im.name;
+        EXPECT_GT(im.fit_psnr_unshadowed, 15.0) << im.name;  // an unshadowed fit of a shadowed photo
         EXPECT_GT(im.shadowed.psnr, 35.0) << im.name;
         EXPECT_GT(im.shadowed.ssim, 0.95) << im.name;
         EXPECT_EQ(im.panels.shadowed.width, im.panels.truth.width);
@@ -156,6 +157,7 @@ TEST(Holdout, CliWritesTheReport) {
         stem.replace_extension();
         EXPECT_TRUE(fs::exists(report + "/sheets/" + stem.string() + ".png")) << v->name;
         EXPECT_TRUE(fs::exists(report + "/env/" + stem.string() + "_sh.txt")) << v->name;
+        EXPECT_TRUE(fs::exists(report + "/env/" + stem.string() + "_unshadowed_sh.txt")) << v->name;
     }
     EXPECT_TRUE(fs::exists(report + "/report.md"));
 }

@@ -8,8 +8,9 @@
 //   fit mask    the scene's mask (soft values as stored; all ones without one) on columns x < W/2
 //   score mask  official_eval_mask (eval/metrics.h: 5x5 erosion, fully covered pixels) of the scene's mask
 //               binarised at 0.5, on columns x >= W/2
-// Both renders use the one fitted light: the shadowed fit (default) scores shadowed and unshadowed alike,
-// as the sol-nerf protocol scores both with the angle picked on the shadowed render.
+// Each render is scored under its own fit: the shadowed render under the light fitted to the shadowed render,
+// the unshadowed one under the light fitted to the unshadowed render, so that neither is judged with a
+// light tuned for the other (an unshadowed model compensates missing shadows with a dimmer light).
 #include <string>
 #include <vector>
 
@@ -24,7 +25,7 @@
 namespace lumigauss {
 
 struct HoldoutOptions {
-    LightFitOptions fit;  // variable (default Embedding for a run with a lighting network), iterations, ...
+    LightFitOptions fit;  // variable, iterations, ... (`shadowed` is set per fit)
     SsimOptions ssim;     // win 5, as the official evaluation
     Split views = Split::Test;
     bool keep_panels = true;
@@ -33,11 +34,13 @@ struct HoldoutOptions {
 struct HoldoutImageResult {
     std::string name;
     std::size_t fit_pixels = 0, score_pixels = 0;
-    double fit_psnr = 0;  // masked PSNR of the fitted render on the left half (how well the fit went)
+    // Masked PSNR of each fitted render on the left half (how well the fit went).
+    double fit_psnr = 0, fit_psnr_unshadowed = 0;
     double fit_ms = 0, render_ms = 0;
-    ShCoeffs<double> light;             // the fitted environment SH
+    ShCoeffs<double> light;             // the environment SH fitted to the shadowed render
+    ShCoeffs<double> light_unshadowed;  // ... and to the unshadowed one
     ImageMetrics shadowed, unshadowed;  // on the right half
-    // The contact sheet's panels (report.h's SheetPanels): photo, clamped renders under the fitted light,
+    // The contact sheet's panels (report.h's SheetPanels): photo, clamped renders under their fitted lights,
     // albedo (clamped), normals, shadow image, and as `mask` the score mask. No ground-truth panels.
     GtEnvPanels panels;
 };
@@ -48,7 +51,7 @@ struct HoldoutResult {
     Split views = Split::Test;
     std::vector<HoldoutImageResult> images;
     ImageMetrics mean_shadowed, mean_unshadowed;  // PSNR averaged as PSNR, as officially
-    double mean_fit_psnr = 0, median_fit_ms = 0, median_render_ms = 0;
+    double mean_fit_psnr = 0, mean_fit_psnr_unshadowed = 0, median_fit_ms = 0, median_render_ms = 0;
 };
 
 // Fit mask and score mask of a view (see above) from the scene's mask as loaded (empty: no mask).

@@ -5,14 +5,17 @@
 //   sheets/NAME.png    photo | shadowed | unshadowed | albedo | normals | shadow
 //                      score mask | |shadowed - photo| x4 | |unshadowed - photo| x4 | (black: no ground
 //                      truth)
-//   env/NAME_sh.txt    the light fitted on the left half of each photo (`lumigauss render --light`)
+//   env/NAME_sh.txt, env/NAME_unshadowed_sh.txt
+//                      the lights fitted on the left half of each photo (`lumigauss render --light`)
 // metrics.json:
 //   {"protocol": "holdout", "run", "scene", "downscale", "views", "fit": {"variable", "iterations",
-//    "render", "fit_mask", "score_mask"},
-//    "images": [{"name", "fit_pixels", "score_pixels", "fit_psnr", "fit_ms", "render_ms",
-//                "environment_sh": [[r, g, b] x 9], "shadowed": {"psnr", "ssim", "mse", "mae"},
+//    "renders", "fit_mask", "score_mask"},
+//    "images": [{"name", "fit_pixels", "score_pixels", "fit_psnr": {"shadowed", "unshadowed"}, "fit_ms",
+//                "render_ms", "environment_sh": {"shadowed": [[r, g, b] x 9], "unshadowed": [...]},
+//                "shadowed": {"psnr", "ssim", "mse", "mae"},
 //                "unshadowed": {...}}],
-//    "mean": {"shadowed", "unshadowed", "fit_psnr"}, "median_fit_ms", "median_render_ms"}
+//    "mean": {"shadowed", "unshadowed", "fit_psnr": {"shadowed", "unshadowed"}}, "median_fit_ms",
+//    "median_render_ms"}
 // Non-finite numbers are written as null.
 #include <nlohmann/json.hpp>
 #include <string>
