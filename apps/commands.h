@@ -12,5 +12,6 @@ void register_info(CLI::App& app);
 void register_render(CLI::App& app);
 void register_synth(CLI::App& app);
 void register_train(CLI::App& app);
+void register_view(CLI::App& app);
 
 }  // namespace lumigauss::cli

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
     lumigauss::cli::register_render(app);
     lumigauss::cli::register_synth(app);
     lumigauss::cli::register_train(app);
+    lumigauss::cli::register_view(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

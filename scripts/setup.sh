@@ -4,8 +4,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# chromium: only for the viewer's browser tests (headless, software WebGL) and bench/viewer_bench.sh.
 PACKAGES=(build-essential cmake pkg-config git libtbb-dev libglm-dev libstb-dev libtinyexr-dev libpng-dev
-          libcli11-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev)
+          libcli11-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev chromium)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -1,0 +1,150 @@
+// `lumigauss view SOURCE [--port P] [--light L ...]`: serves the real-time relighting viewer (web/viewer/,
+// embedded in the binary) for a trained run or a bare relightable PLY on http://127.0.0.1:P/ until Ctrl-C.
+// The page renders in WebGL2: orbit camera, environment from the training photos' learned lightings or an SH
+// file, environment rotation, shadowed/unshadowed/albedo/normals/shadow views (src/lumigauss/view/).
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <optional>
+
+#include "commands.h"
+#include "lumigauss/io/dataset.h"
+#include "lumigauss/relight/camera_json.h"
+#include "lumigauss/relight/light_source.h"
+#include "lumigauss/relight/up_axis.h"
+#include "lumigauss/train/trained_run.h"
+#include "lumigauss/util/error.h"
+#include "lumigauss/view/http_server.h"
+#include "lumigauss/view/model_payload.h"
+#include "lumigauss/view/scene_info.h"
+#include "lumigauss/view/viewer_site.h"
+
+namespace lumigauss::cli {
+namespace {
+
+struct ViewOptions {
+    std::string source, scene, camera_json, up = "+z", bench_report;
+    std::vector<std::string> lights;
+    int port = 8080;
+};
+
+// The server Ctrl-C stops. A plain pointer read by the signal handler: set before the handler is installed,
+// cleared after it is removed.
+view::HttpServer* g_server = nullptr;
+
+extern "C" void on_stop_signal(int) {
+    if (g_server) g_server->stop();  // async-signal-safe: one write() to a pipe
+}
+
+// Installs SIGINT/SIGTERM handlers for the lifetime of the object, restoring the previous ones after.
+class StopSignals {
+  public:
+    explicit StopSignals(view::HttpServer& server) {
+        g_server = &server;
+        struct sigaction sa = {};
+        sa.sa_handler = on_stop_signal;
+        sigemptyset(&sa.sa_mask);
+        sigaction(SIGINT, &sa, &old_int_);
+        sigaction(SIGTERM, &sa, &old_term_);
+    }
+    ~StopSignals() {
+        sigaction(SIGINT, &old_int_, nullptr);
+        sigaction(SIGTERM, &old_term_, nullptr);
+        g_server = nullptr;
+    }
+    StopSignals(const StopSignals&) = delete;
+    StopSignals& operator=(const StopSignals&) = delete;
+
+  private:
+    struct sigaction old_int_ = {};
+    struct sigaction old_term_ = {};
+};
+
+// The cameras "auto" estimates the up axis from, the initial one first: --camera (its first entry) wins over
+// --scene (its first training view).
+std::vector<Camera> known_cameras(const ViewOptions& o) {
+    std::vector<Camera> cams;
+    if (!o.camera_json.empty())
+        for (const NamedCamera& c : read_camera_json(o.camera_json)) cams.push_back(c.camera);
+    if (!o.scene.empty()) {
+        const Dataset scene = load_dataset(o.scene);
+        const std::vector<const View*> train = scene.split(Split::Train);
+        if (!train.empty()) cams.push_back(train.front()->camera);
+        for (const View& v : scene.views) cams.push_back(v.camera);
+    }
+    return cams;
+}
+
+Vec3d resolve_up(const ViewOptions& o, const std::vector<Camera>& cams) {
+    if (o.up != "auto") return parse_up_axis(o.up);
+    if (cams.empty())
+        throw Error("view: --up auto estimates the up axis from cameras: give --scene or --camera");
+    return estimate_up_axis(cams);
+}
+
+void run_view(const ViewOptions& o) {
+    const TrainedRun run = load_run_or_ply(o.source);
+    const std::vector<Camera> cams = known_cameras(o);
+    const Vec3d up = resolve_up(o, cams);
+    PanoramaOptions popt;
+    popt.frame = panorama_frame_for_up(up);
+    std::vector<ResolvedLight> lights;
+    for (const std::string& spec : o.lights) lights.push_back(resolve_light(spec, run, popt));
+    std::optional<Camera> initial;
+    if (!cams.empty()) initial = cams.front();
+    const view::ViewerScene scene = view::describe_scene(run, lights, up, initial);
+
+    view::HttpServer* server_ptr = nullptr;
+    view::ViewerSiteOptions site_options;
+    site_options.bench_report_path = o.bench_report;
+    site_options.on_report = [&server_ptr] {
+        if (server_ptr) server_ptr->stop();
+    };
+    view::ViewerSite site(view::encode_model_payload(run.model), view::scene_json(scene), site_options);
+    view::HttpServerOptions server_options;
+    server_options.port = o.port;
+    // The bench report travels in the query string of a GET: allow long request heads only then.
+    server_options.max_request_bytes = o.bench_report.empty() ? 16384 : 8u << 20;
+    view::HttpServer server(server_options, [&site](const view::HttpRequest& r) { return site.handle(r); });
+    server_ptr = &server;
+    StopSignals signals(server);
+    std::printf("view: %zu surfels, %zu lights, up %s\nview: open http://127.0.0.1:%d/ (Ctrl-C to stop)\n",
+                run.model.size(), scene.lights.size(), up_axis_name(up).c_str(), server.port());
+    std::fflush(stdout);
+    server.run();
+    std::printf("view: stopped\n");
+}
+
+}  // namespace
+
+void register_view(CLI::App& app) {
+    auto o = std::make_shared<ViewOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "view",
+        "Serve the real-time relighting viewer (WebGL2) for a trained run or a relightable .ply on "
+        "http://127.0.0.1:PORT/ (loopback only) until Ctrl-C");
+    cmd->add_option("source", o->source,
+                    "training run folder (model.ply, lighting.lgmlp, appearance.json) or a relightable .ply "
+                    "(official LumiGauss layout)")
+        ->required();
+    cmd->add_option("--port", o->port, "TCP port on 127.0.0.1 (0: a free one; the URL is printed)")
+        ->capture_default_str();
+    cmd->add_option("--light", o->lights,
+                    "extra lighting(s) offered first: a training photo's name, a .txt SH file (9 rows R G B) "
+                    "or a panorama, as for `render --light` (repeatable)");
+    cmd->add_option("--up", o->up,
+                    "world up axis for orbiting and turning the environment: +z (default), -y, +y, +x, -x, "
+                    "-z, or auto (from --scene/--camera)")
+        ->capture_default_str();
+    cmd->add_option("--scene", o->scene,
+                    "scene folder (COLMAP or NeRF-OSR): its first training view is the initial camera");
+    cmd->add_option("--camera", o->camera_json,
+                    "camera JSON (as for `render --cameras FILE`): its first camera is the initial view");
+    // Hidden (empty group): for the browser test and bench/viewer_bench.sh.
+    cmd->add_option("--bench-report", o->bench_report,
+                    "accept one GET /bench-report?data=JSON from the page, write it to FILE and exit")
+        ->group("");
+    cmd->callback([o] { run_view(*o); });
+}
+
+}  // namespace lumigauss::cli

@@ -1,0 +1,53 @@
+#pragma once
+// What the viewer's page needs besides the surfels (GET /scene.json): the lightings to choose from, the up
+// axis, an initial camera and the model's extent. JSON, for example
+//   {"format": "lumigauss-viewer-scene", "version": 1, "surfels": 200000,
+//    "up": [0, 0, 1], "up_name": "+z", "e1": [1, 0, 0], "e2": [0, 1, 0],
+//    "centre": [x, y, z], "radius": r,
+//    "camera": null | {"width": W, "height": H, "fx": .., "fy": .., "cx": .., "cy": ..,
+//                      "R": [[..], [..], [..]], "t": [..]},          (relight/camera_json.h conventions)
+//    "lights": [{"name": "IMG_0001.jpg", "kind": "training photo", "sh": [[R, G, B] x 9]}, ...],
+//    "initial_light": 0}
+// Lights in order: those given with --light, then every training photo's learned lighting (embedding
+// order), then "uniform" (constant radiance with irradiance 1 everywhere, for inspecting albedo and
+// geometry). SH are radiance L_lm in the world frame (shading/sh.h order). up, e1, e2 form the right-handed
+// orbit frame of relight/orbit.h (azimuth a = cos a e1 + sin a e2). centre is the per-axis median of the
+// surfel positions, radius the 90th percentile of their distance to it (robust to stray surfels).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "lumigauss/io/camera.h"
+#include "lumigauss/math/vec.h"
+#include "lumigauss/relight/light_source.h"
+#include "lumigauss/shading/sh.h"
+#include "lumigauss/train/trained_run.h"
+
+namespace lumigauss::view {
+
+struct ViewerLight {
+    std::string name;
+    std::string kind;  // light_kind_name(), or "uniform"
+    ShCoeffs<double> sh;
+};
+
+struct ViewerScene {
+    std::size_t surfels = 0;
+    Vec3d up{0, 0, 1};
+    Vec3d centre{};
+    double radius = 1;
+    std::optional<Camera> camera;  // the initial view when known (--scene, --camera)
+    std::vector<ViewerLight> lights;
+};
+
+// The uniform environment: radiance 1 / pi in every direction, so irradiance(L, n) = 1 for every n.
+ShCoeffs<double> uniform_environment();
+
+// Builds the description from the run, the --light lights (already resolved, in order) and the options.
+ViewerScene describe_scene(const TrainedRun& run, const std::vector<ResolvedLight>& extra_lights, Vec3d up,
+                           std::optional<Camera> camera);
+
+// The JSON text above.
+std::string scene_json(const ViewerScene& scene);
+
+}  // namespace lumigauss::view

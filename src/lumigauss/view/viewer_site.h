@@ -1,0 +1,41 @@
+#pragma once
+// The viewer's routes (the request handler of http_server.h). Everything served is in memory; a request
+// can only name one of these, never a file:
+//   /                 index.html
+//   /NAME             an embedded asset of web/viewer/ (viewer_assets.h), with its Content-Type
+//   /model.bin        the model payload (model_payload.h), application/octet-stream
+//   /scene.json       lights, up axis, initial camera, extent (scene_info.h), application/json
+//   /bench-report     only with a report path (the hidden `view --bench-report FILE`, for tests and
+//                     bench/viewer_bench.sh): GET /bench-report?data=<URL-encoded JSON object> writes the
+//                     object to FILE (atomically) and calls on_report (which stops the server); answered
+//                     once, 404 otherwise.
+// A target that url_path.h refuses gets 400; any other name 404.
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "lumigauss/view/http_message.h"
+
+namespace lumigauss::view {
+
+struct ViewerSiteOptions {
+    std::string bench_report_path;    // empty: no /bench-report route
+    std::function<void()> on_report;  // called after a report is written
+};
+
+class ViewerSite {
+  public:
+    ViewerSite(std::string model_payload, std::string scene_json, ViewerSiteOptions options);
+    // Thread-safe: the server calls it from one thread per connection.
+    HttpResponse handle(const HttpRequest& request);
+
+  private:
+    HttpResponse bench_report(const std::string& query);
+
+    std::shared_ptr<const std::string> model_, scene_;
+    ViewerSiteOptions options_;
+    std::atomic<bool> reported_{false};
+};
+
+}  // namespace lumigauss::view

@@ -1,0 +1,369 @@
+// The viewer page: loads scene.json and model.bin from the server (src/lumigauss/view/), renders with
+// renderer.js, sorts in sort_worker.js, and wires the controls. With ?bench=N (tests, bench/viewer_bench.sh)
+// it renders N frames while orbiting and reports frame-time statistics to the server instead; with
+// &cam=W,H,fx,fy,cx,cy,R(9),t(3) it first renders every view from that fixed camera and reports the pixels,
+// &rot=DEG turns the environment, &mode=VIEW picks the view of the orbit frames, &controls first drives every
+// control and reports which worked, and &target8 forces the 8-bit render target.
+import { decodePayload, packSplats } from './model.js';
+import { OrbitCamera, parseCameraParam } from './orbit.js';
+import { SplatRenderer } from './renderer.js';
+import { MODES } from './shaders.js';
+import { parseShText, rotateAboutUp, scaleSh } from './sh.js';
+
+const NEAR = 0.2;  // render/raster_constants.h kNearPlane
+const $ = (id) => document.getElementById(id);
+
+// The sorting worker, asked for the latest view only: a request while one is running replaces the queued
+// one. `sorted(view)` resolves once a sort for that view (or a later one) has been applied.
+class DepthSorter {
+  constructor(positions, onSorted) {
+    this.worker = new Worker('sort_worker.js');
+    this.worker.onerror = (e) => window.__lgError(`sort worker: ${e.message}`);
+    this.worker.onmessage = (e) => this.received(e.data);
+    this.worker.postMessage({ type: 'init', positions: positions.slice() });
+    this.onSorted = onSorted;
+    this.nextId = 1;
+    this.busy = false;
+    this.queued = null;
+    this.waiters = [];
+    this.times = [];
+  }
+
+  request(view) {
+    const msg = { type: 'sort', id: this.nextId++, r2: view.R[2], tz: view.t[2], near: NEAR };
+    if (this.busy) this.queued = msg;
+    else this.send(msg);
+    return msg.id;
+  }
+
+  sorted(view) {
+    const id = this.request(view);
+    return new Promise((resolve) => this.waiters.push({ id, resolve }));
+  }
+
+  send(msg) {
+    this.busy = true;
+    this.worker.postMessage(msg);
+  }
+
+  received(m) {
+    this.busy = false;
+    this.times.push(m.ms);
+    this.onSorted(m.indices, m.count);
+    this.waiters = this.waiters.filter((w) => (w.id <= m.id ? (w.resolve(), false) : true));
+    if (this.queued) {
+      this.send(this.queued);
+      this.queued = null;
+    }
+  }
+}
+
+async function fetchOk(url) {
+  const r = await fetch(url);
+  if (!r.ok) throw new Error(`${url}: HTTP ${r.status}`);
+  return r;
+}
+
+const nextFrame = () => new Promise((resolve) => requestAnimationFrame(resolve));
+
+function percentile(values, q) {
+  if (!values.length) return null;
+  const s = values.slice().sort((a, b) => a - b);
+  return s[Math.min(s.length - 1, Math.floor(q * s.length))];
+}
+
+function stats(values) {
+  const mean = values.reduce((a, b) => a + b, 0) / Math.max(values.length, 1);
+  return { median: percentile(values, 0.5), p90: percentile(values, 0.9), mean, count: values.length };
+}
+
+function base64(bytes) {
+  let s = '';
+  for (let i = 0; i < bytes.length; i += 0x8000) s += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
+  return btoa(s);
+}
+
+class Viewer {
+  constructor(scene, model) {
+    this.scene = scene;
+    this.lights = scene.lights.map((l) => ({ name: l.name, kind: l.kind, sh: l.sh }));
+    this.lightIndex = scene.initial_light || 0;
+    this.rotation = 0;
+    this.exposure = 0;
+    this.mode = 'shadowed';
+    this.ball = { mode: 0, size: 110 };
+    this.renderer = new SplatRenderer($('canvas'));
+    this.renderer.setModel(packSplats(model, this.renderer.maxTextureSize));
+    this.camera = new OrbitCamera(scene);
+    this.sorter = new DepthSorter(model.xyz, (indices, count) => {
+      this.renderer.setOrder(indices, count);
+      this.dirty = true;
+    });
+    this.count = model.count;
+    this.dirty = true;
+    this.updateEnvironment();
+  }
+
+  // exposure * light SH, turned about the up axis, as the shader's uniform.
+  updateEnvironment() {
+    const light = this.lights[this.lightIndex];
+    const sh = rotateAboutUp(scaleSh(light.sh, 2 ** this.exposure), this.scene.up, this.rotation);
+    this.env = new Float32Array(sh.flat());
+    this.dirty = true;
+  }
+
+  canvasSize() {
+    const c = this.renderer.canvas, dpr = window.devicePixelRatio || 1;
+    return [Math.max(1, Math.round(c.clientWidth * dpr)), Math.max(1, Math.round(c.clientHeight * dpr))];
+  }
+
+  draw(view, withBall = true) {
+    this.renderer.render(view, this.env, this.mode, withBall && this.ball.mode !== 'off' ? this.ball : null);
+  }
+
+  // --- interactive use ---
+
+  start() {
+    this.bindControls();
+    let lastKey = '';
+    const frame = () => {
+      const [w, h] = this.canvasSize();
+      const view = this.camera.view(w, h);
+      const key = JSON.stringify([view.R, view.t]);
+      if (key !== lastKey) {
+        this.sorter.request(view);
+        lastKey = key;
+        this.dirty = true;
+      }
+      if (this.dirty) {
+        const t0 = performance.now();
+        this.draw(view);
+        this.dirty = false;
+        const sort = this.sorter.times.length ? this.sorter.times[this.sorter.times.length - 1] : 0;
+        $('stats').textContent = `${this.count} splats (${this.renderer.instances} in front)\n` +
+          `sort ${sort.toFixed(1)} ms (worker)\ndraw calls ${(performance.now() - t0).toFixed(1)} ms (CPU)\n` +
+          `${this.renderer.floatTarget ? 'float' : '8-bit'} target, ${this.renderer.rendererName}`;
+      }
+      requestAnimationFrame(frame);
+    };
+    requestAnimationFrame(frame);
+  }
+
+  fillLightMenu() {
+    const select = $('light');
+    select.textContent = '';
+    this.lights.forEach((l, i) => {
+      const o = document.createElement('option');
+      o.value = String(i);
+      o.textContent = l.kind === 'training photo' || l.kind === l.name ? l.name : `${l.name} (${l.kind})`;
+      select.appendChild(o);
+    });
+    select.value = String(this.lightIndex);
+  }
+
+  bindControls() {
+    this.fillLightMenu();
+    const touch = () => (this.dirty = true);
+    $('light').onchange = (e) => { this.lightIndex = Number(e.target.value); this.updateEnvironment(); };
+    $('rotation').oninput = (e) => {
+      this.rotation = Number(e.target.value);
+      $('rotationValue').textContent = e.target.value;
+      this.updateEnvironment();
+    };
+    $('exposure').oninput = (e) => {
+      this.exposure = Number(e.target.value);
+      $('exposureValue').textContent = e.target.value;
+      this.updateEnvironment();
+    };
+    $('mode').onchange = (e) => { this.mode = e.target.value; touch(); };
+    $('ball').onchange = (e) => { this.ball.mode = e.target.value === 'off' ? 'off' : Number(e.target.value); touch(); };
+    $('reset').onclick = () => { this.camera.reset(); touch(); };
+    $('shfile').onchange = (e) => this.loadShFile(e.target.files[0]);
+    this.bindPointer($('canvas'));
+    window.addEventListener('resize', touch);
+  }
+
+  async loadShFile(file) {
+    if (!file) return;
+    try {
+      const sh = parseShText(await file.text());
+      this.lights.push({ name: file.name, kind: 'SH file', sh });
+      this.lightIndex = this.lights.length - 1;
+      this.fillLightMenu();
+      this.updateEnvironment();
+      $('message').textContent = '';
+    } catch (err) {
+      $('message').textContent = `${file.name}: ${err.message}`;
+    }
+  }
+
+  bindPointer(canvas) {
+    let last = null;
+    canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+    canvas.addEventListener('pointerdown', (e) => {
+      try {
+        canvas.setPointerCapture(e.pointerId);  // keeps the drag when the pointer leaves the canvas
+      } catch (err) {
+        // not an active pointer (a synthetic event): dragging works without capture
+      }
+      last = { x: e.clientX, y: e.clientY, pan: e.button === 2 || e.button === 1 || e.shiftKey };
+    });
+    canvas.addEventListener('pointermove', (e) => {
+      if (!last) return;
+      const dx = e.clientX - last.x, dy = e.clientY - last.y;
+      last.x = e.clientX, last.y = e.clientY;
+      if (last.pan) this.camera.pan(dx, dy, canvas.clientHeight);
+      else this.camera.orbit(dx, dy, canvas.clientHeight);
+    });
+    const end = () => (last = null);
+    canvas.addEventListener('pointerup', end);
+    canvas.addEventListener('pointercancel', end);
+    canvas.addEventListener('wheel', (e) => {
+      e.preventDefault();
+      this.camera.zoom(Math.exp(e.deltaY * 0.0015));
+    }, { passive: false });
+    canvas.addEventListener('dblclick', () => this.camera.reset());
+  }
+
+  // --- bench and test mode ---
+
+  // Every view from a fixed camera, without the ball, as RGB rows from the top.
+  async shots(view) {
+    const canvas = this.renderer.canvas;
+    canvas.classList.add('fixed');
+    canvas.style.width = `${view.width}px`;
+    canvas.style.height = `${view.height}px`;
+    await this.sorter.sorted(view);
+    const out = {};
+    for (const mode of MODES) {
+      this.mode = mode;
+      this.draw(view, false);
+      const img = this.renderer.readRgb();
+      out[mode] = { width: img.width, height: img.height, rgb: base64(img.rgb) };
+    }
+    this.mode = 'shadowed';
+    canvas.classList.remove('fixed');
+    canvas.style.width = canvas.style.height = '';
+    return out;
+  }
+
+  // N frames turning the orbit camera once around; each frame is drawn and waited for (GPU included).
+  async orbitFrames(frames) {
+    await nextFrame();
+    const [w, h] = this.canvasSize();
+    await this.sorter.sorted(this.camera.view(w, h));
+    this.sorter.times = [];
+    const frameMs = [], intervals = [];
+    let previous = null;
+    for (let i = 0; i < frames; ++i) {
+      const stamp = await nextFrame();
+      if (previous !== null) intervals.push(stamp - previous);
+      previous = stamp;
+      const t0 = performance.now();
+      this.camera.azimuth += (2 * Math.PI) / frames;
+      const view = this.camera.view(w, h);
+      this.sorter.request(view);
+      this.draw(view);
+      this.renderer.finish();
+      frameMs.push(performance.now() - t0);
+    }
+    await this.sorter.sorted(this.camera.view(w, h));
+    this.draw(this.camera.view(w, h));
+    const img = this.renderer.readRgb();
+    let lit = 0;
+    for (let p = 0; p < img.rgb.length; p += 3) if (img.rgb[p] + img.rgb[p + 1] + img.rgb[p + 2] > 6) ++lit;
+    return {
+      width: w, height: h, frame_ms: stats(frameMs), raf_interval_ms: stats(intervals),
+      sort_ms: stats(this.sorter.times), nonblank_fraction: lit / (img.width * img.height),
+    };
+  }
+
+  // Drives every control the way a user would (events on the real elements) and reports whether each one
+  // changed the viewer's state: the tests' check that the page is wired up.
+  async checkControls() {
+    const fire = (id, type, value) => {
+      const el = $(id);
+      if (value !== undefined) el.value = value;
+      el.dispatchEvent(new Event(type));
+    };
+    const checks = {};
+    const env0 = this.env.slice();
+    fire('rotation', 'input', '90');
+    checks.rotation = this.rotation === 90 && this.env.some((v, i) => v !== env0[i]);
+    fire('exposure', 'input', '1');
+    checks.exposure = this.exposure === 1;
+    fire('mode', 'change', 'albedo');
+    checks.mode = this.mode === 'albedo';
+    fire('ball', 'change', 'off');
+    checks.ball = this.ball.mode === 'off';
+    fire('light', 'change', String(this.lights.length - 1));
+    checks.light = this.lightIndex === this.lights.length - 1;
+    const file = new DataTransfer();
+    file.items.add(new File(['1 1 1\n0 0 0\n0.5 0.5 0.5\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n'], 'test_sh.txt'));
+    $('shfile').files = file.files;
+    await this.loadShFile($('shfile').files[0]);
+    checks.sh_file = this.lights[this.lightIndex].name === 'test_sh.txt' && this.env[6] === 0.5 * 2;
+    const canvas = $('canvas'), az = this.camera.azimuth, dist = this.camera.distance;
+    const pointer = (type, x, extra = {}) =>
+      canvas.dispatchEvent(new PointerEvent(type, { pointerId: 1, clientX: x, clientY: 10, button: 0, buttons: 1, ...extra }));
+    pointer('pointerdown', 10);
+    pointer('pointermove', 60);
+    pointer('pointerup', 60);
+    checks.orbit = this.camera.azimuth !== az;
+    canvas.dispatchEvent(new WheelEvent('wheel', { deltaY: 100, cancelable: true }));
+    checks.zoom = this.camera.distance > dist;
+    canvas.dispatchEvent(new MouseEvent('dblclick'));
+    checks.reset = this.camera.azimuth === az && this.camera.distance === dist;
+    // Back to the state the rest of the bench expects.
+    fire('rotation', 'input', '0');
+    fire('exposure', 'input', '0');
+    fire('mode', 'change', 'shadowed');
+    fire('ball', 'change', '0');
+    this.lights.pop();
+    this.lightIndex = this.scene.initial_light || 0;
+    this.fillLightMenu();
+    this.updateEnvironment();
+    return checks;
+  }
+
+  async bench(params) {
+    const report = {
+      splats: this.count, renderer: this.renderer.rendererName, float_target: this.renderer.floatTarget,
+      user_agent: navigator.userAgent,
+    };
+    if (params.has('controls')) {
+      this.bindControls();
+      report.controls = await this.checkControls();
+    }
+    const degrees = Number(params.get('rot') || 0);
+    this.rotation = degrees;
+    this.updateEnvironment();
+    // The page's SH rotation, for the test to compare with the C++ rotate_about_up.
+    report.rotation_check = { up: this.scene.up, degrees: 37, sh: this.lights[this.lightIndex].sh,
+                              rotated: rotateAboutUp(this.lights[this.lightIndex].sh, this.scene.up, 37) };
+    const cam = params.get('cam');
+    if (cam) {
+      const view = parseCameraParam(cam);
+      if (!view) throw new Error(`cam=${cam}: expected 18 numbers W,H,fx,fy,cx,cy,R(9),t(3)`);
+      report.shots = await this.shots(view);
+    }
+    if (MODES.includes(params.get('mode'))) this.mode = params.get('mode');
+    report.mode = this.mode;
+    Object.assign(report, await this.orbitFrames(Math.max(1, Number(params.get('bench')))));
+    await window.__lgReport(report);
+    $('stats').textContent = `bench done: median ${report.frame_ms.median.toFixed(1)} ms`;
+  }
+}
+
+async function main() {
+  const params = new URLSearchParams(location.search);
+  const [scene, buffer] = await Promise.all([
+    fetchOk('scene.json').then((r) => r.json()),
+    fetchOk('model.bin').then((r) => r.arrayBuffer()),
+  ]);
+  const viewer = new Viewer(scene, decodePayload(buffer));
+  if (params.has('bench')) await viewer.bench(params);
+  else viewer.start();
+}
+
+main().catch((err) => window.__lgError(err && err.stack ? err.stack : err));
