@@ -15,7 +15,7 @@
 #include "lumigauss/relight/light_fit.h"
 #include "lumigauss/shading/sh_text.h"
 #include "lumigauss/train/trained_run.h"
-#include "lumigauss/train/view_shading.h"
+#include "support/clamped_render.h"
 #include "support/run_cli.h"
 #include "synth_test_util.h"
 
@@ -55,12 +55,7 @@ struct FitSetup {
         write_png(photo, rendered(r, view.camera, light));
     }
     static Image rendered(const TrainedRun& r, const Camera& cam, const ShCoeffs<double>& sh) {
-        const RasterImages<float> img =
-            render_with_environment(r.model, cam, sh.cast<float>(), ShadingMode::Shadowed);
-        Image out(cam.width, cam.height, 3);
-        for (std::size_t i = 0; i < out.pixels.size(); ++i)
-            out.pixels[i] = std::clamp(img.color[i], 0.0f, 1.0f);
-        return out;
+        return testing::clamped_render(r.model, cam, sh);
     }
     // PSNR over the pixels the model covers, of the run rendered under `sh` against the photo.
     double psnr_with(const ShCoeffs<double>& sh) const {

@@ -11,8 +11,8 @@
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/train/trained_run.h"
-#include "lumigauss/train/view_shading.h"
 #include "lumigauss/util/error.h"
+#include "support/clamped_render.h"
 #include "support/run_cli.h"
 #include "synth_test_util.h"
 
@@ -69,16 +69,9 @@ struct HoldoutScene {
         const TrainedRun run = load_trained_run(run_dir);
         light = run.learned_sh(1);
         const Dataset d = load_dataset(copy, {});
-        for (const View* v : d.split(Split::Test)) write_png(v->image_path, render(run, v->camera, light));
+        for (const View* v : d.split(Split::Test))
+            write_png(v->image_path, testing::clamped_render(run.model, v->camera, light));
         ok = true;
-    }
-    static Image render(const TrainedRun& run, const Camera& cam, const ShCoeffs<double>& sh) {
-        const RasterImages<float> img =
-            render_with_environment(run.model, cam, sh.cast<float>(), ShadingMode::Shadowed);
-        Image out(cam.width, cam.height, 3);
-        for (std::size_t i = 0; i < out.pixels.size(); ++i)
-            out.pixels[i] = std::clamp(img.color[i], 0.0f, 1.0f);
-        return out;
     }
 };
 

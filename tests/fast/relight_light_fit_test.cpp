@@ -12,6 +12,7 @@
 #include "lumigauss/train/view_shading.h"
 #include "lumigauss/util/error.h"
 #include "relight_test_util.h"
+#include "support/clamped_render.h"
 #include "support/random_surfels.h"
 
 namespace lumigauss {
@@ -30,12 +31,8 @@ ShCoeffs<double> true_light(std::uint64_t seed) {
 
 Image render_photo(const GaussianModel& model, const Camera& cam, const ShCoeffs<double>& env,
                    bool shadowed) {
-    const RasterImages<float> img = render_with_environment(
-        model, cam, env.cast<float>(), shadowed ? ShadingMode::Shadowed : ShadingMode::Unshadowed);
-    Image photo(cam.width, cam.height, 3);
-    for (std::size_t i = 0; i < photo.pixels.size(); ++i)
-        photo.pixels[i] = std::clamp(img.color[i], 0.0f, 1.0f);
-    return photo;
+    return testing::clamped_render(model, cam, env,
+                                   shadowed ? ShadingMode::Shadowed : ShadingMode::Unshadowed);
 }
 
 // |a - b| / |b| over the 27 coefficients.
