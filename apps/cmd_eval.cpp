@@ -45,13 +45,19 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// -r when given, else the run's training resolution (1 when the run does not record it).
+DatasetOptions evaluated_resolution(const EvalOptions& o, int run_downscale) {
+    DatasetOptions dopt;
+    dopt.downscale = o.downscale > 0 ? o.downscale : (run_downscale > 0 ? run_downscale : 1);
+    return dopt;
+}
+
 void run_gt_env(const EvalOptions& o) {
     const auto t0 = std::chrono::steady_clock::now();
     // Check the scene's ground truth before the (slower) model load, so a wrong scene fails at once.
     const GtSceneMeta meta = load_gt_scene_meta(o.scene);
     const RelightableRun run = load_relightable_run(o.run);
-    DatasetOptions dopt;
-    dopt.downscale = o.downscale > 0 ? o.downscale : (run.downscale > 0 ? run.downscale : 1);
+    const DatasetOptions dopt = evaluated_resolution(o, run.downscale);
     const Dataset scene = load_dataset(o.scene, dopt);
     if (!o.quiet)
         std::printf("eval: %zu surfels, %zu training photos from %s; %zu %s views of %s at 1/%d\n",
@@ -140,8 +146,7 @@ void run_sol_nerf(const EvalOptions& o) {
     // Check the config before the (slower) model load, so a wrong config fails at once.
     const SolNerfConfig config = load_sol_nerf_config(sol_config_path(o));
     const TrainedRun run = load_run_or_ply(o.run);
-    DatasetOptions dopt;
-    dopt.downscale = o.downscale > 0 ? o.downscale : (run.downscale > 0 ? run.downscale : 1);
+    const DatasetOptions dopt = evaluated_resolution(o, run.downscale);
     const Dataset scene = load_dataset(o.scene, dopt);
     if (!o.quiet)
         std::printf("eval: %zu surfels from %s; %zu test images of %s at 1/%d, config %s, %d angles each\n",
@@ -170,8 +175,7 @@ void run_sol_nerf(const EvalOptions& o) {
 void run_holdout(const EvalOptions& o) {
     const auto t0 = std::chrono::steady_clock::now();
     const TrainedRun run = load_run_or_ply(o.run);
-    DatasetOptions dopt;
-    dopt.downscale = o.downscale > 0 ? o.downscale : (run.downscale > 0 ? run.downscale : 1);
+    const DatasetOptions dopt = evaluated_resolution(o, run.downscale);
     const Dataset scene = load_dataset(o.scene, dopt);
     HoldoutOptions hopt;
     hopt.views = o.views == "train" ? Split::Train : Split::Test;

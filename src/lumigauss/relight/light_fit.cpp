@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <span>
 
 #include "lumigauss/eval/metrics.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/train/adam.h"
 #include "lumigauss/train/image_losses.h"
@@ -110,7 +110,6 @@ class LightParameters {
     }
 
     const std::vector<float>& values() const { return values_; }
-    void set_values(const std::vector<float>& v) { values_ = v; }
 
   private:
     LightVariable variable_;
@@ -211,12 +210,7 @@ const char* light_variable_name(LightVariable v) {
 ShCoeffs<double> default_initial_sh(const TrainedRun& run) {
     ShCoeffs<double> sh{};
     const int n = int(run.image_names.size());
-    if (n == 0 || run.lighting.num_images() == 0) {
-        // E(n) = A_0 L_00 Y_00 = pi L_00 Y_00 = 1 for every normal.
-        const double dc = 1.0 / (std::numbers::pi * sh_const::kY00);
-        sh.c[0] = Vec3d{dc, dc, dc};
-        return sh;
-    }
+    if (n == 0 || run.lighting.num_images() == 0) return uniform_irradiance_environment<double>();
     for (int i = 0; i < n; ++i) {
         const ShCoeffs<double> l = run.learned_sh(i);
         for (int k = 0; k < kShCount; ++k) sh.c[k] = sh.c[k] + l.c[k] * (1.0 / n);
@@ -230,9 +224,17 @@ LightFitResult fit_light(const TrainedRun& run, const Camera& camera, const Imag
     LightParameters light(run, options);
     FrozenViewObjective objective(run, camera, photo, mask, options);
 
+    // The best iterate so far: its parameters, its light and its scores (the loss and PSNR evaluate() gave
+    // for those parameters, before the step that followed).
+    struct Iterate {
+        std::vector<float> values;
+        ShCoeffs<float> env{};
+        double loss = std::numeric_limits<double>::infinity(), psnr = 0;
+    } best;
+    const auto keep_if_best = [&](const ShCoeffs<float>& env, double loss, double psnr) {
+        if (std::isfinite(loss) && loss < best.loss) best = {light.values(), env, loss, psnr};
+    };
     LightFitResult result;
-    double best_loss = std::numeric_limits<double>::infinity();
-    std::vector<float> best_values = light.values();
     const double decay = std::log(options.final_lr_fraction);
     for (int it = 0; it < options.iterations; ++it) {
         const ShCoeffs<float> env = light.sh();
@@ -244,26 +246,22 @@ LightFitResult fit_light(const TrainedRun& run, const Camera& camera, const Imag
                 throw Error("fit-light: no surfel of the model covers a pixel the fit uses (wrong camera?)");
             result.initial_loss = v.loss, result.initial_psnr = v.psnr;
         }
-        if (v.loss < best_loss) best_loss = v.loss, best_values = light.values();
+        keep_if_best(env, v.loss, v.psnr);
         if (options.progress) options.progress(it, v.loss, v.psnr);
         light.set_gradient(v.g_env);
         light.step(std::exp(decay * it / std::max(1, options.iterations - 1)));
     }
     // The last step's result has not been scored yet.
-    {
-        const ShCoeffs<float> env = light.sh();
-        const auto v = objective.evaluate(env, options.iterations, false);
-        if (std::isfinite(v.loss) && v.loss < best_loss) best_loss = v.loss, best_values = light.values();
-    }
-    light.set_values(best_values);
-    const ShCoeffs<float> env = light.sh();
-    const auto final_value = objective.evaluate(env, options.iterations, false);
-    result.sh = env.cast<double>();
-    if (options.variable == LightVariable::Embedding) result.embedding = best_values;
+    const ShCoeffs<float> last = light.sh();
+    const auto v = objective.evaluate(last, options.iterations, false);
+    keep_if_best(last, v.loss, v.psnr);
+
+    result.sh = best.env.cast<double>();
+    if (options.variable == LightVariable::Embedding) result.embedding = best.values;
     result.iterations = options.iterations;
-    result.final_loss = final_value.loss;
-    result.final_psnr = final_value.psnr;
-    result.env_loss = objective.env_loss(env, options.iterations);
+    result.final_loss = best.loss;
+    result.final_psnr = best.psnr;
+    result.env_loss = objective.env_loss(best.env, options.iterations);
     return result;
 }
 

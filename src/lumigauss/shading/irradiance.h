@@ -106,4 +106,14 @@ LG_HD constexpr void shadowed_radiance_vjp(const T transfer[kShCount], const ShC
     }
 }
 
+// The constant environment whose irradiance is `e` for every normal: E = A_0 Y_00 L_00 = C4 L_00 (the other
+// coefficients 0). A neutral grey sky for inspecting albedo, and the start of a light fit with no prior.
+template <typename T>
+LG_HD constexpr ShCoeffs<T> uniform_irradiance_environment(T e = T(1)) {
+    ShCoeffs<T> sh{};
+    const T l00 = e / T(rh_const::kC4);
+    sh.c[0] = Vec3<T>{l00, l00, l00};
+    return sh;
+}
+
 }  // namespace lumigauss

@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <numbers>
 
 #include <nlohmann/json.hpp>
 
 #include "lumigauss/relight/orbit.h"
 #include "lumigauss/relight/up_axis.h"
+#include "lumigauss/shading/irradiance.h"
 
 namespace lumigauss::view {
 namespace {
@@ -54,11 +54,7 @@ std::string light_name(const ResolvedLight& light) {
 }  // namespace
 
 ShCoeffs<double> uniform_environment() {
-    ShCoeffs<double> sh;
-    // irradiance = pi * Y00 * L00 for a constant environment: L00 = 1 / (pi Y00) gives 1.
-    const double l00 = 1.0 / (std::numbers::pi * sh_const::kY00);
-    sh.c[0] = {l00, l00, l00};
-    return sh;
+    return uniform_irradiance_environment<double>();
 }
 
 ViewerScene describe_scene(const TrainedRun& run, const std::vector<ResolvedLight>& extra_lights, Vec3d up,
