@@ -7,8 +7,8 @@
 # Runs go to --runs (default runs/<scene name>): a run that has its model is only evaluated again; one with a
 # checkpoint is resumed (so an interrupted benchmark continues where it stopped); otherwise it is trained.
 # --ablations adds the rows of the paper's ablation (Table 1, lower part), each a full training:
-#   no_stage1      without the unshadowed warm-up: transfer fitting from iteration 1 (warmup=1, 500 iterations
-#                  of stage 2 as officially), then shadowed. (No densification: it only runs in stage 1.)
+#   no_stage1      without the unshadowed warm-up: transfer fitting from iteration 1 (warmup=1, then the preset's
+#                  stage-2 length: 500 iterations as officially, 100 in the fast preset), then shadowed. (No densification: it only runs in stage 1.)
 #   no_cons_unsh   without l_consistency and the unshadowed reconstruction term in the last stage
 #                  (consistency_final_ratio=0, lambda_unshadowed_stage3=0; stage 2 still fits the transfer)
 #   no_range01     without l_[0,1] (lambda_range01=0)
@@ -43,7 +43,9 @@ bin="$build/lumigauss"
 declare -a names=(baseline) settings=("")
 if [[ $ablations == 1 ]]; then
     names+=(no_stage1 no_cons_unsh no_range01 no_env_pos)
-    settings+=("--set warmup=1 --set start_shadowed=501"
+    # Stage 2 (transfer fitting) keeps the preset's length: 500 iterations in the paper preset, 100 in fast.
+    stage2=$([[ $preset == fast ]] && echo 100 || echo 500)
+    settings+=("--set warmup=1 --set start_shadowed=$((stage2 + 1))"
                "--set consistency_final_ratio=0 --set lambda_unshadowed_stage3=0"
                "--set lambda_range01=0"
                "--set lambda_env=0")

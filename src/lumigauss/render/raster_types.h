@@ -86,7 +86,7 @@ struct RasterState {
 
     // Binning scratch, kept so that a loop reusing one RasterState does not allocate it again per call.
     std::vector<std::uint64_t> sort_keys;
-    std::vector<std::uint32_t> emission_tile, emission_surfel;
+    std::vector<std::uint32_t> emission_surfel;
 
     std::size_t intersections() const { return entry_surfel.size(); }
 };
