@@ -5,8 +5,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # chromium: only for the viewer's browser tests (headless, software WebGL) and bench/viewer_bench.sh.
+# ffmpeg: run (never linked) by `render --spin` / `--cameras orbit` to make MP4s; without it only frames.
 PACKAGES=(build-essential cmake pkg-config git libtbb-dev libglm-dev libstb-dev libtinyexr-dev libpng-dev
-          libcli11-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev chromium)
+          libcli11-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev chromium ffmpeg)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

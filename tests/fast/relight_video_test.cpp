@@ -1,15 +1,18 @@
 // The MP4 step of the relighting tool (relight/video.h): shell quoting survives any file name, '%' in paths
 // is escaped for ffmpeg's image pattern, and encode_video renames a finished encode into place and leaves
-// nothing behind when the encoder fails (checked with stand-in `ffmpeg` scripts, so no ffmpeg is needed).
+// nothing behind when the encoder fails (checked with stand-in `ffmpeg` scripts, so no ffmpeg is needed);
+// where ffmpeg is installed (scripts/setup.sh installs it), a real encode is read back with ffprobe.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "lumigauss/io/image.h"
 #include "lumigauss/relight/video.h"
 #include "support/temp_dir.h"
 
@@ -83,6 +86,50 @@ TEST(RelightVideo, EncodeRenamesIntoPlaceOrLeavesNothing) {
     EXPECT_FALSE(encode_video(bad, tmp / "f_%03d.png", out2, 15));
     EXPECT_FALSE(fs::exists(out2));
     EXPECT_FALSE(fs::exists(out2 + ".tmp.mp4"));
+}
+
+// The real encoder: odd-sized frames come out as an MP4 (ISO base media: an `ftyp` box first) of even size
+// with every frame, and the frames' order survives (a bright square moves across).
+TEST(RelightVideo, RealFfmpegEncodesEveryFrame) {
+    const std::string ffmpeg = find_on_path("ffmpeg");
+    if (ffmpeg.empty()) GTEST_SKIP() << "ffmpeg is not installed (scripts/setup.sh installs it)";
+    TempDir tmp("relight_ffmpeg");
+    const int frames = 5, width = 33, height = 21;
+    for (int k = 0; k < frames; ++k) {
+        Image frame(width, height, 3, 0.1f);
+        for (int y = 8; y < 14; ++y)
+            for (int x = 4 * k; x < 4 * k + 6; ++x)
+                for (int c = 0; c < 3; ++c) frame.at(x, y, c) = 0.9f;
+        char name[32];
+        std::snprintf(name, sizeof name, "f %% %03d.png", k);
+        write_png(tmp / name, frame);
+    }
+    const std::string out = tmp / "turn table.mp4";
+    ASSERT_TRUE(encode_video(ffmpeg, escape_percent(tmp / "f % ") + "%03d.png", out, 15));
+    const std::string bytes = read_file(out);
+    ASSERT_GT(bytes.size(), 8u);
+    EXPECT_EQ(bytes.substr(4, 4), "ftyp");
+    EXPECT_FALSE(fs::exists(out + ".tmp.mp4"));
+
+    const std::string ffprobe = find_on_path("ffprobe");
+    if (ffprobe.empty()) return;
+    const std::string probe = tmp / "probe.txt";
+    const std::string cmd = shell_quote(ffprobe) +
+                            " -v error -count_frames -select_streams v:0 -show_entries "
+                            "stream=width,height,nb_read_frames -of csv=p=0 " +
+                            shell_quote(out) + " > " + shell_quote(probe);
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    EXPECT_EQ(read_file(probe), "34,22,5\n");  // padded to even sizes, all five frames
+
+    // The last frame decoded: the square is where frame 4 had it, not where frame 0 did.
+    const std::string last = tmp / "last.png";
+    const std::string decode = shell_quote(ffmpeg) + " -v error -i " + shell_quote(out) +
+                               " -vf 'select=eq(n\\,4)' -frames:v 1 " + shell_quote(last);
+    ASSERT_EQ(std::system(decode.c_str()), 0) << decode;
+    const Image decoded = read_image(last);
+    ASSERT_EQ(decoded.width, 34);
+    EXPECT_GT(decoded.at(18, 10, 1), 0.7f);  // inside frame 4's square (x 16..21)
+    EXPECT_LT(decoded.at(2, 10, 1), 0.3f);   // inside frame 0's square only
 }
 
 }  // namespace
