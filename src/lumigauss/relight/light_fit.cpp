@@ -5,6 +5,7 @@
 #include <span>
 
 #include "lumigauss/eval/metrics.h"
+#include "lumigauss/render/cpu/blend_weights.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/surfel_shading.h"
@@ -134,6 +135,12 @@ class FrozenViewObjective {
         model_.activated(batch_);
         compute_view_normals(model_, camera_, normals_);
         shape_ = ImageShape{photo.width, photo.height, 3};
+        // The geometry is frozen, so the blending weights of one rasterisation serve every step: each
+        // evaluation only re-shades the surfels and composites with them (and back), which is exact.
+        shade_surfels(model_, uniform_irradiance_environment<float>(), mode_, normals_, batch_);
+        rasterize_forward_cpu(camera_, batch_, settings_, state_, images_);
+        weights_ = blend_weights(state_);
+        state_ = {};  // only the weights and the alpha map are used from here on
     }
 
     struct Value {
@@ -144,7 +151,7 @@ class FrozenViewObjective {
     Value evaluate(const ShCoeffs<float>& env, int iteration, bool with_gradient) {
         Value v;
         shade_surfels(model_, env, mode_, normals_, batch_);
-        rasterize_forward_cpu(camera_, batch_, settings_, state_, images_);
+        composite(weights_, batch_.colors, batch_.channels, images_.color);
         std::span<const float> rendered = images_.color;  // 3 channels in either single mode
         grad_.color.assign(with_gradient ? rendered.size() : 0, 0.0f);
         std::span<float> g = grad_.color;
@@ -173,10 +180,10 @@ class FrozenViewObjective {
 
   private:
     void add_render_gradient(const ShCoeffs<float>& env, ShCoeffs<float>& g_env) {
-        grad_.width = shape_.width, grad_.height = shape_.height, grad_.channels = 3;
-        const SurfelGrads<float> sg = rasterize_backward_cpu(batch_, state_, grad_);
+        g_colors_.resize(batch_.colors.size());
+        composite_backward(weights_, grad_.color, batch_.channels, g_colors_);
         model_.zero_grad();  // the model's own gradients are a by-product here, never used
-        const ShCoeffs<float> g_shading = shade_surfels_backward(model_, env, mode_, normals_, sg.colors);
+        const ShCoeffs<float> g_shading = shade_surfels_backward(model_, env, mode_, normals_, g_colors_);
         for (int k = 0; k < kShCount; ++k) g_env.c[k] = g_env.c[k] + g_shading.c[k];
     }
 
@@ -198,7 +205,9 @@ class FrozenViewObjective {
     RasterSettings<float> settings_;
     RasterState<float> state_;
     RasterImages<float> images_;
+    BlendWeights weights_;
     RasterImageGrads<float> grad_;
+    std::vector<float> g_colors_;
 };
 
 }  // namespace
