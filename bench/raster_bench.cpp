@@ -5,29 +5,32 @@
 
 #include "bench_scene.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/render/cpu/tile_blocks.h"
 
 namespace lumigauss::bench {
 namespace {
 
-// Work counts of one render: (pixel, surfel) pairs inside the surfels' boxes, and vector lanes the tiles
-// evaluate (8 or 16 per row of a box, see tile_forward.h's lane_window).
+// Work counts of one render: (pixel, surfel) pairs inside the surfels' boxes, and vector lanes: 8 per
+// (surfel, block of 4 x 2 pixels) pair whose box overlaps the block (tile_blocks.h), all of which a
+// forward without early termination would evaluate.
 struct WorkCounts {
-    double pairs = 0, lanes = 0, rows = 0;
+    double pairs = 0, lanes = 0;
 };
 
 template <typename T>
 WorkCounts work_counts(const RasterState<T>& st) {
     WorkCounts w;
+    cpu::BlockLists lists;
     for (int t = 0; t < st.tiles_x * st.tiles_y; ++t) {
-        const int tx = t % st.tiles_x, ty = t / st.tiles_x, ts = raster::kTileSize;
+        const raster::PixelRect tile = cpu::tile_pixels(t, st.tiles_x, st.view.width, st.view.height);
         for (std::uint32_t e = st.tile_start[t]; e < st.tile_start[t + 1]; ++e) {
             const raster::PixelRect& r = st.entry_rect[e];
-            const int cols = std::min(r.x1, tx * ts + ts - 1) - std::max(r.x0, tx * ts) + 1;
-            const int rows = std::min(r.y1, ty * ts + ts - 1) - std::max(r.y0, ty * ts) + 1;
+            const int cols = std::min(r.x1, tile.x1) - std::max(r.x0, tile.x0) + 1;
+            const int rows = std::min(r.y1, tile.y1) - std::max(r.y0, tile.y0) + 1;
             w.pairs += double(cols) * rows;
-            w.rows += rows;
-            w.lanes += double(rows) * (cols <= 8 ? 8 : 16);
         }
+        cpu::build_block_lists(st, t, tile, lists);
+        w.lanes += 8.0 * double(lists.items.size());  // eight lanes per block
     }
     return w;
 }

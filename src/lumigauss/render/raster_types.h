@@ -78,7 +78,12 @@ struct RasterState {
     std::vector<raster::PixelRect> entry_rect;
     std::vector<Vec3<T>> entry_normal;
     std::vector<T> entry_color;
-    std::vector<T> final_transmittance;       // per pixel
+    // Per tile, per block of 4 x 2 pixels (the CPU backend's unit of work, render/cpu/tile_blocks.h): the
+    // tile's entries, as indices from its first, that the forward composited into at least one of the
+    // block's pixels, front to back. The backward walks exactly these.
+    std::vector<std::vector<std::uint32_t>> block_entries;  // per tile
+    std::vector<std::uint32_t> block_start;                 // per tile: blocks + 1 offsets into its list
+    std::vector<T> final_transmittance;                     // per pixel
     std::vector<std::uint32_t> contributors;  // per pixel: entries up to the last composited, in its tile
     std::vector<std::int32_t> median_entry;   // per pixel: sorted entry giving the median depth, or -1
     std::vector<T> m1, m2;                    // per pixel: sum w m, sum w m^2 (distortion)

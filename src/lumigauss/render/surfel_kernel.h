@@ -9,39 +9,71 @@
 
 namespace lumigauss::raster {
 
+// The kernel's formulas are written once for a "lane" type L: a scalar (float or double: the reference, the
+// blending-weight recorder, a CUDA thread) or a pack of pixels (the CPU backend's cpu::Pack8). For a pack,
+// comparisons give a per-lane mask and lane_select picks per lane; for a scalar, a bool and ?:.
 template <typename T>
+LG_HD_INLINE T lane_select(bool m, T a, T b) {
+    return m ? a : b;
+}
+template <typename L>
+using LaneMask = decltype(L{} < L{});
+
+// The scalar type of a lane type (L itself for scalars).
+template <typename L>
+struct LaneScalar {
+    using type = L;
+};
+template <typename L>
+requires requires {
+    typename L::Scalar;
+}
+struct LaneScalar<L> {
+    using type = typename L::Scalar;
+};
+template <typename L>
+using lane_scalar_t = typename LaneScalar<L>::type;
+
+LG_HD_INLINE float exp2_integer(float k) {
+    const int bits = (int(k) + 127) << 23;
+    float scale;
+    __builtin_memcpy(&scale, &bits, sizeof(float));
+    return scale;
+}
+LG_HD_INLINE double lane_exp(double x) {
+    return std::exp(x);
+}
+
+template <typename L>
 struct SplatSample {
-    T alpha{};                   // min(kAlphaMax, opacity * gauss)
-    T gauss{};                   // max of the object-space Gaussian and the screen-space filter
-    T u{}, v{};                  // intersection in the surfel's (u, v) frame (object branch only)
-    T z{};                       // depth of this contribution
-    bool screen_branch = false;  // the screen low-pass filter won
-    bool clamped = false;        // alpha hit kAlphaMax
+    L alpha{};                    // min(kAlphaMax, opacity * gauss)
+    L gauss{};                    // max of the object-space Gaussian and the screen-space filter
+    L u{}, v{};                   // intersection in the surfel's (u, v) frame (object branch only)
+    L z{};                        // depth of this contribution
+    LaneMask<L> screen_branch{};  // the screen low-pass filter won
+    LaneMask<L> clamped{};        // alpha hit kAlphaMax
 };
 
 // exp(x) for the kernel's arguments (x <= 0). Float: range reduction to 2^k exp(r), |r| <= ln2/2, and a
 // degree-6 polynomial (Cephes expf coefficients, about 1 ulp) written without branches or libm calls so
-// that loops over pixels vectorise; double: std::exp (references and finite-difference tests).
-template <typename T>
-LG_HD_INLINE T kernel_exp(T x) {
-    if constexpr (sizeof(T) == sizeof(float)) {
-        x = x < -87.0f ? -87.0f : x;
+// that it vectorises; double: std::exp (references and finite-difference tests).
+template <typename L>
+LG_HD_INLINE L kernel_exp(L x) {
+    if constexpr (sizeof(lane_scalar_t<L>) == sizeof(float)) {
+        x = lane_select(x < L(-87.0f), L(-87.0f), x);
         const float round_magic = 12582912.0f;  // 1.5 * 2^23: adding it rounds to an integer
-        const float k = (x * 1.44269504088896341f + round_magic) - round_magic;
-        const float r = (x - k * 0.693359375f) - k * -2.12194440e-4f;
-        float p = 1.9875691500e-4f;
-        p = p * r + 1.3981999507e-3f;
-        p = p * r + 8.3334519073e-3f;
-        p = p * r + 4.1665795894e-2f;
-        p = p * r + 1.6666665459e-1f;
-        p = p * r + 5.0000001201e-1f;
-        const float er = p * r * r + r + 1.0f;
-        const int bits = (int(k) + 127) << 23;
-        float scale;
-        __builtin_memcpy(&scale, &bits, sizeof(float));
-        return er * scale;
+        const L k = (x * L(1.44269504088896341f) + L(round_magic)) - L(round_magic);
+        const L r = (x - k * L(0.693359375f)) - k * L(-2.12194440e-4f);
+        L p = L(1.9875691500e-4f);
+        p = p * r + L(1.3981999507e-3f);
+        p = p * r + L(8.3334519073e-3f);
+        p = p * r + L(4.1665795894e-2f);
+        p = p * r + L(1.6666665459e-1f);
+        p = p * r + L(5.0000001201e-1f);
+        const L er = p * r * r + r + L(1.0f);
+        return er * exp2_integer(k);
     } else {
-        return std::exp(x);
+        return lane_exp(x);
     }
 }
 
@@ -73,63 +105,34 @@ LG_HD inline SplatGeometry<T> make_splat_geometry(Vec3<T> tu, Vec3<T> tv, Vec3<T
     return g;
 }
 
-// Evaluates the surfel at pixel centre (px, py). Returns false when the pair does not contribute:
-// the ray is parallel to the disk, the hit is nearer than the near plane, or alpha < kAlphaMin.
-// Written without early returns (every test folds into the result) so that loops over pixels vectorise;
-// a parallel ray makes u, v infinite or NaN, and every comparison below then fails.
-template <typename T>
-LG_HD_INLINE bool evaluate_splat(const SplatGeometry<T>& g, T px, T py, SplatSample<T>& s) {
-    const T dx = px - g.center.x, dy = py - g.center.y;
-    const Vec3<T> p = dx * g.pa + dy * g.pb + g.pd;
-    const T inv_pz = T(1) / p.z;
-    s.u = p.x * inv_pz;
-    s.v = p.y * inv_pz;
-    const T rho_object = s.u * s.u + s.v * s.v;
-    const T rho_screen = T(kFilterInvSquare) * (dx * dx + dy * dy);
+// Evaluates the surfel at pixel centre(s) (px, py). The result (true, or the lanes) says where the pair
+// contributes: not where the ray is parallel to the disk, the hit is nearer than the near plane, or
+// alpha < kAlphaMin. Written without early returns (every test folds into the result) so that it runs on
+// packs of pixels; a parallel ray makes u, v infinite or NaN, and every comparison below then fails.
+template <typename T, typename L>
+LG_HD_INLINE LaneMask<L> evaluate_splat(const SplatGeometry<T>& g, L px, L py, SplatSample<L>& s) {
+    const L dx = px - L(g.center.x), dy = py - L(g.center.y);
+    const L p_x = dx * L(g.pa.x) + dy * L(g.pb.x) + L(g.pd.x);
+    const L p_y = dx * L(g.pa.y) + dy * L(g.pb.y) + L(g.pd.y);
+    const L p_z = dx * L(g.pa.z) + dy * L(g.pb.z) + L(g.pd.z);
+    const L inv_pz = L(1) / p_z;
+    s.u = p_x * inv_pz;
+    s.v = p_y * inv_pz;
+    const L rho_object = s.u * s.u + s.v * s.v;
+    const L rho_screen = L(kFilterInvSquare) * (dx * dx + dy * dy);
     s.screen_branch = rho_screen < rho_object;
-    const T rho = s.screen_branch ? rho_screen : rho_object;
+    const L rho = lane_select(s.screen_branch, rho_screen, rho_object);
     // The screen branch uses the centre depth (the pinned rasterizer of the official code): far from the
     // disk, or at grazing angles, the intersection depth is meaningless.
-    s.z = s.screen_branch ? g.tw.z : g.tw.x * s.u + g.tw.y * s.v + g.tw.z;
-    // A ray parallel to the disk (p.z == 0) never contributes. The tests are folded into selects on
-    // floats rather than ANDs of masks: that form vectorises with GCC.
-    const T rho_checked = p.z != T(0) ? rho : std::numeric_limits<T>::infinity();
-    const bool in_reach = rho_checked <= g.rho_cutoff;  // also false for NaN
-    s.gauss = kernel_exp(T(-0.5) * (in_reach ? rho : T(0)));
-    const T a = g.opacity * s.gauss;
-    s.clamped = a > T(kAlphaMax);
-    s.alpha = s.clamped ? T(kAlphaMax) : a;
-    return (in_reach ? s.z : T(-1)) >= T(kNearPlane) && s.alpha >= T(kAlphaMin);
-}
-
-// One surfel against a whole tile row of pixels (px0, px0 + 1, ..., px0 + kTileSize - 1), as arrays: the
-// pass the CPU backend vectorises before it composites the contributing pixels one by one. A fixed width
-// (no remainder loop) keeps short rows on the vector path; pixels outside [lo, hi] get alpha 0.
-template <typename T>
-struct RowSamples {
-    T alpha[kTileSize];  // 0 where the pair does not contribute
-    T z[kTileSize], u[kTileSize], v[kTileSize], gauss[kTileSize];
-    T screen[kTileSize];   // 1 where the screen filter won
-    T clamped[kTileSize];  // 1 where alpha hit kAlphaMax
-};
-
-// W (8 or 16) lanes starting at px0: callers use an 8-pixel window for boxes that fit in one, which halves
-// the work on processors whose 16-wide vectors are two 8-wide halves.
-template <int W = kTileSize, typename T>
-LG_HD_INLINE void evaluate_splat_row(const SplatGeometry<T>& geometry, T px0, T py, int lo, int hi,
-                                     RowSamples<T>& out) {
-    const SplatGeometry<T> g = geometry;  // a local copy: the outputs cannot alias it, so the loop vectorises
-    const T lo_t = T(lo), hi_t = T(hi);
-    for (int i = 0; i < W; ++i) {
-        SplatSample<T> s;
-        const bool ok = evaluate_splat(g, px0 + T(i), py, s);
-        const T a = ok ? s.alpha : T(0);
-        const T a_lo = T(i) >= lo_t ? a : T(0);
-        out.alpha[i] = T(i) <= hi_t ? a_lo : T(0);
-        out.z[i] = s.z, out.u[i] = s.u, out.v[i] = s.v, out.gauss[i] = s.gauss;
-        out.screen[i] = s.screen_branch ? T(1) : T(0);
-        out.clamped[i] = s.clamped ? T(1) : T(0);
-    }
+    s.z = lane_select(s.screen_branch, L(g.tw.z), L(g.tw.x) * s.u + L(g.tw.y) * s.v + L(g.tw.z));
+    // A ray parallel to the disk (p.z == 0) never contributes.
+    const L rho_checked = lane_select(p_z != L(0), rho, L(std::numeric_limits<lane_scalar_t<L>>::infinity()));
+    const LaneMask<L> in_reach = rho_checked <= L(g.rho_cutoff);  // also false for NaN
+    s.gauss = kernel_exp(L(-0.5) * lane_select(in_reach, rho, L(0)));
+    const L a = L(g.opacity) * s.gauss;
+    s.clamped = a > L(kAlphaMax);
+    s.alpha = lane_select(s.clamped, L(kAlphaMax), a);
+    return (lane_select(in_reach, s.z, L(-1)) >= L(kNearPlane)) & (s.alpha >= L(kAlphaMin));
 }
 
 // Gradient accumulators of one surfel over many pixels, in the kernel's own variables: the per-pixel work
@@ -143,56 +146,41 @@ struct SplatGrad {
 };
 
 // What one pixel contributes to the surfel's kernel gradients, given dL/dalpha and dL/dz for the pair.
-// Branch-free (both filter branches computed, one selected, and every value of the branch not taken
-// zeroed before it can become inf * 0), so that it vectorises over pixels.
-template <typename T>
+template <typename L>
 struct SplatGradTerms {
-    Vec3<T> g_p;   // dL/d(homogeneous hit p); dL/dpa = dx g_p, dL/dpb = dy g_p, dL/dpd = g_p
-    T dx, dy;      // pixel - filter centre
-    Vec3<T> g_tw;  // direct dependence through z
-    Vec2<T> g_center;
-    T g_opacity;
+    Vec3<L> g_p;   // dL/d(homogeneous hit p); dL/dpa = dx g_p, dL/dpb = dy g_p, dL/dpd = g_p
+    L dx, dy;      // pixel - filter centre
+    Vec3<L> g_tw;  // direct dependence through z
+    Vec2<L> g_center;
+    L g_opacity;
 };
 
-// The sample is passed field by field (not as SplatSample) so that vectorised callers need not assemble
-// structs with bool members per pixel.
-template <typename T>
-LG_HD_INLINE SplatGradTerms<T> splat_grad_terms(const SplatGeometry<T>& g, T px, T py, T sample_u, T sample_v,
-                                                T gauss, bool screen_branch, bool clamped, T g_alpha, T g_z) {
-    SplatGradTerms<T> t;
+// Branch-free: both filter branches computed, one selected, and every value of the branch not taken
+// zeroed before it can become inf * 0. `screen_branch` may also be set for pixels the pair does not
+// reach: with g_alpha = g_z = 0 there, every term is then exactly 0 whatever u, v and p.z are.
+template <typename T, typename L>
+LG_HD_INLINE SplatGradTerms<L> splat_grad_terms(const SplatGeometry<T>& g, L px, L py, L sample_u, L sample_v,
+                                                L gauss, LaneMask<L> screen_branch, LaneMask<L> clamped,
+                                                L g_alpha, L g_z) {
+    SplatGradTerms<L> t;
     // The alpha clamp is differentiated exactly: no gradient through a clamped alpha.
-    const T ga = clamped ? T(0) : g_alpha;
+    const L ga = lane_select(clamped, L(0), g_alpha);
     t.g_opacity = gauss * ga;
-    const T g_gauss = g.opacity * ga;
-    t.dx = px - g.center.x;
-    t.dy = py - g.center.y;
-    const bool obj = !screen_branch;
+    const L g_gauss = L(g.opacity) * ga;
+    t.dx = px - L(g.center.x);
+    t.dy = py - L(g.center.y);
     // Screen branch: gauss = exp(-|pix - c|^2), so d gauss / d c = 2 (pix - c) gauss; z = tw.z.
-    const T k2 = obj ? T(0) : T(kFilterInvSquare) * gauss * g_gauss;
+    const L k2 = lane_select(screen_branch, L(kFilterInvSquare) * gauss * g_gauss, L(0));
     t.g_center = {k2 * t.dx, k2 * t.dy};
     // Object branch: gauss = exp(-(u^2 + v^2) / 2), z = tw . (u, v, 1), (u, v) = (p.x, p.y) / p.z.
-    const T u = obj ? sample_u : T(0), v = obj ? sample_v : T(0);
-    const T g_u = -u * gauss * g_gauss + (obj ? g_z * g.tw.x : T(0));
-    const T g_v = -v * gauss * g_gauss + (obj ? g_z * g.tw.y : T(0));
-    const T p_z = t.dx * g.pa.z + t.dy * g.pb.z + g.pd.z;
-    const T inv_pz = obj ? T(1) / p_z : T(0);
+    const L u = lane_select(screen_branch, L(0), sample_u), v = lane_select(screen_branch, L(0), sample_v);
+    const L g_u = -u * gauss * g_gauss + lane_select(screen_branch, L(0), g_z * L(g.tw.x));
+    const L g_v = -v * gauss * g_gauss + lane_select(screen_branch, L(0), g_z * L(g.tw.y));
+    const L p_z = t.dx * L(g.pa.z) + t.dy * L(g.pb.z) + L(g.pd.z);
+    const L inv_pz = lane_select(screen_branch, L(0), L(1) / p_z);
     t.g_p = {g_u * inv_pz, g_v * inv_pz, -(g_u * u + g_v * v) * inv_pz};
     t.g_tw = {g_z * u, g_z * v, g_z};
     return t;
-}
-
-// Backward of evaluate_splat for one pixel: adds the gradients from dL/dalpha and dL/dz to `acc`.
-template <typename T>
-LG_HD inline void evaluate_splat_vjp(const SplatGeometry<T>& g, T px, T py, const SplatSample<T>& s,
-                                     T g_alpha, T g_z, SplatGrad<T>& acc) {
-    const SplatGradTerms<T> t =
-        splat_grad_terms(g, px, py, s.u, s.v, s.gauss, s.screen_branch, s.clamped, g_alpha, g_z);
-    acc.pa += t.dx * t.g_p;
-    acc.pb += t.dy * t.g_p;
-    acc.pd += t.g_p;
-    acc.tw += t.g_tw;
-    acc.center = acc.center + t.g_center;
-    acc.opacity += t.g_opacity;
 }
 
 // Converts accumulated kernel gradients to gradients on the ray-transform rows (pa = tv x tw, pb = tw x tu,

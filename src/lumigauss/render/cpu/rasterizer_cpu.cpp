@@ -1,6 +1,7 @@
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -173,8 +174,12 @@ void rasterize_forward_cpu(const Camera& camera, const SurfelBatch<T>& surfels,
     st.m2.resize(np);
     allocate_images(img, camera.width, camera.height, surfels.channels);
     const int num_tiles = st.tiles_x * st.tiles_y;
+    st.block_entries.resize(std::size_t(num_tiles));
+    st.block_start.resize(std::size_t(num_tiles) * (cpu::kTileBlocks + 1));
+    tbb::enumerable_thread_specific<cpu::TileScratch<T>> scratch;
     tbb::parallel_for(tbb::blocked_range<int>(0, num_tiles, 1), [&](const auto& r) {
-        for (int t = r.begin(); t != r.end(); ++t) cpu::forward_tile(t, surfels, st, img);
+        cpu::TileScratch<T>& mine = scratch.local();
+        for (int t = r.begin(); t != r.end(); ++t) cpu::forward_tile(t, surfels, st, img, mine);
     });
 }
 
@@ -188,8 +193,10 @@ SurfelGrads<T> rasterize_backward_cpu(const SurfelBatch<T>& surfels, const Raste
     const std::unique_ptr<T[]> slot_buffer(new T[st.intersections() * std::size_t(stride)]);
     T* slots = slot_buffer.get();
     const int num_tiles = st.tiles_x * st.tiles_y;
+    tbb::enumerable_thread_specific<cpu::TileScratch<T>> scratch;
     tbb::parallel_for(tbb::blocked_range<int>(0, num_tiles, 1), [&](const auto& r) {
-        for (int t = r.begin(); t != r.end(); ++t) cpu::backward_tile(t, surfels, st, grads, slots);
+        cpu::TileScratch<T>& mine = scratch.local();
+        for (int t = r.begin(); t != r.end(); ++t) cpu::backward_tile(t, surfels, st, grads, slots, mine);
     });
     SurfelGrads<T> out;
     out.means.assign(3 * n, T(0));

@@ -1,0 +1,136 @@
+#pragma once
+// Front-to-back compositing of one pixel (or one pack of pixels) and its backward, shared by every backend.
+//
+// A pixel blends the samples of the surfels covering it in depth order: w_i = alpha_i T_i with
+// T_{i+1} = T_i (1 - alpha_i), into colour, expected depth, normal and the depth-distortion map, and records
+// the median depth and its contributor. The backward walks the same samples back to front, recovering
+// T_i = T_{i+1} / (1 - alpha_i) and keeping the blends of the samples behind, which is all dL/dalpha_i needs.
+// L is a lane type (see surfel_kernel.h): a scalar, or a pack of pixels on the CPU.
+#include <cstdint>
+
+#include "lumigauss/math/vec.h"
+#include "lumigauss/render/raster_constants.h"
+#include "lumigauss/render/surfel_kernel.h"
+
+namespace lumigauss::raster {
+
+// Integer per lane: sorted-entry indices and contributor counts.
+template <typename L>
+struct LaneIndexOf {
+    using type = std::int32_t;
+};
+template <typename L>
+requires requires {
+    typename L::Index;
+}
+struct LaneIndexOf<L> {
+    using type = typename L::Index;
+};
+template <typename L>
+using LaneIndex = typename LaneIndexOf<L>::type;
+
+// The running sums of the forward walk.
+template <typename L, int C>
+struct BlendPixel {
+    L live{};   // 1 while the pixel still blends; 0 once finished (or for a lane off the image)
+    L trans{};  // transmittance in front of the next sample: start at 1
+    L color[C]{}, depth{}, normal[3]{}, distortion{};
+    L m1{}, m2{};  // sum w m and sum w m^2 of the mapped depth m (distortion)
+    L median{};
+    LaneIndex<L> median_entry{};  // sorted entry giving the median depth: start at -1
+    LaneIndex<L> contributors{};  // rank of the last composited sample: start at 0
+};
+
+// Blends one sample into the pixel: `alpha` is 0 where the pair does not contribute, `entry` the sample's
+// sorted-entry index and `rank` its position in the tile's list plus one. `channels` <= C colours are read.
+// Returns where the sample was composited.
+template <typename L, int C, typename T>
+LG_HD_INLINE LaneMask<L> blend_sample(BlendPixel<L, C>& s, L alpha, L z, const T* color, int channels,
+                                      Vec3<T> normal, LaneIndex<L> entry, LaneIndex<L> rank) {
+    const L a = alpha * s.live;
+    const L t = s.trans;
+    const L t_next = t * (L(1) - a);
+    // A sample that would take T below the threshold finishes the pixel without being composited.
+    // (a == 0 leaves t_next = t, which is at or above the threshold.)
+    const auto stop = t_next < L(kTransmittanceMin);
+    s.live = lane_select(stop, L(0), s.live);
+    const L w = lane_select(stop, L(0), a * t);
+    for (int c = 0; c < C; ++c) s.color[c] += w * L(c < channels ? color[c] : T(0));
+    const auto composited = w > L(0);
+    const L zc = lane_select(composited, z, L(1));  // z is arbitrary where the pair does not contribute
+    s.depth += w * zc;
+    for (int k = 0; k < 3; ++k) s.normal[k] += w * L(normal[k]);
+    const L m = distortion_depth(zc);
+    s.distortion += w * (m * m * (L(1) - t) + s.m2 - L(2) * m * s.m1);
+    s.m1 += w * m;
+    s.m2 += w * m * m;
+    const auto median = lane_select(composited, t, L(0)) > L(0.5);
+    s.median = lane_select(median, zc, s.median);
+    s.median_entry = lane_select(median, entry, s.median_entry);
+    s.contributors = lane_select(composited, rank, s.contributors);
+    s.trans = lane_select(composited, t_next, t);
+    return composited;
+}
+
+// The state of the backward walk, and the pixel's incoming gradients (zero where a map has none).
+template <typename L, int C>
+struct BlendPixelBackward {
+    L trans{};  // transmittance behind the sample being processed: T_final at first
+    L acc_color[C]{}, acc_normal[3]{}, acc_z{}, acc_alpha{}, acc_dist{};  // blends of the samples behind
+    L g_color[C]{}, g_normal[3]{}, g_depth{}, g_alpha{}, g_dist{}, g_median{};
+    L bg_term{};  // T_final * (background . dL/dcolor)
+    L a_total{};  // 1 - T_final
+    L m1{}, m2{};
+    LaneIndex<L> contributors{}, median_entry{};
+};
+
+// What a composited sample receives.
+template <typename L>
+struct BlendSampleGrad {
+    L g_alpha, g_z;  // dL/dalpha and dL/dz of the sample (0 where it was not composited)
+    L w;             // its blending weight: dL/dcolor_c = w g_color_c, dL/dnormal_k = w g_normal_k
+};
+
+// Un-blends one sample, back to front: `a` is its alpha where the forward composited it, else 0 (which
+// leaves the state unchanged).
+template <typename L, int C, typename T>
+LG_HD_INLINE BlendSampleGrad<L> unblend_sample(BlendPixelBackward<L, C>& s, L a, L z_sample, const T* color,
+                                               int channels, Vec3<T> normal, LaneIndex<L> entry) {
+    const L one_minus_a = L(1) - a;
+    const L t_before = s.trans / one_minus_a;
+    const L w = a * t_before;
+    const auto composited = a > L(0);
+
+    // dL/dalpha: this sample's value against the blend of those behind it, for every map.
+    L g_alpha_inner{};
+    for (int c = 0; c < C; ++c) {
+        const L col = L(c < channels ? color[c] : T(0));
+        g_alpha_inner += (col - s.acc_color[c]) * s.g_color[c];
+    }
+    for (int k = 0; k < 3; ++k) g_alpha_inner += (L(normal[k]) - s.acc_normal[k]) * s.g_normal[k];
+    const L z = lane_select(composited, z_sample, L(1));
+    const L m = distortion_depth(z);
+    const L dist_w = (m * m * s.a_total + s.m2 - L(2) * m * s.m1) * s.g_dist;  // dL/dw of the distortion
+    g_alpha_inner += (z - s.acc_z) * s.g_depth + (L(1) - s.acc_alpha) * s.g_alpha + dist_w - s.acc_dist;
+    BlendSampleGrad<L> out;
+    out.w = w;
+    out.g_alpha = lane_select(composited, t_before * g_alpha_inner - s.bg_term / one_minus_a, L(0));
+    const L g_median = lane_select(s.median_entry == entry, s.g_median, L(0));
+    const L g_z = w * s.g_depth + g_median +
+                  L(2) * w * (m * s.a_total - s.m1) * s.g_dist * distortion_depth_derivative(z);
+    out.g_z = lane_select(composited, g_z, L(0));
+
+    // Fold this sample into the "behind" blends of the sample in front of it.
+    for (int c = 0; c < C; ++c) {
+        const L col = L(c < channels ? color[c] : T(0));
+        s.acc_color[c] = a * col + one_minus_a * s.acc_color[c];
+    }
+    for (int k = 0; k < 3; ++k) s.acc_normal[k] = a * L(normal[k]) + one_minus_a * s.acc_normal[k];
+    s.acc_z = a * z + one_minus_a * s.acc_z;
+    s.acc_alpha = a + one_minus_a * s.acc_alpha;
+    s.acc_dist = a * dist_w + one_minus_a * s.acc_dist;
+    s.trans = t_before;
+    return out;
+}
+
+}  // namespace lumigauss::raster
