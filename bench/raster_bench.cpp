@@ -24,7 +24,7 @@ WorkCounts work_counts(const RasterState<T>& st) {
     for (int t = 0; t < st.tiles_x * st.tiles_y; ++t) {
         const raster::PixelRect tile = cpu::tile_pixels(t, st.tiles_x, st.view.width, st.view.height);
         for (std::uint32_t e = st.tile_start[t]; e < st.tile_start[t + 1]; ++e) {
-            const raster::PixelRect& r = st.entry_rect[e];
+            const raster::PixelRect& r = st.entry_footprint[e].rect;
             const int cols = std::min(r.x1, tile.x1) - std::max(r.x0, tile.x0) + 1;
             const int rows = std::min(r.y1, tile.y1) - std::max(r.y0, tile.y0) + 1;
             w.pairs += double(cols) * rows;
@@ -60,16 +60,41 @@ void set_counters(benchmark::State& state, const RasterState<float>& st, const R
     state.counters["mean_alpha"] = alpha / pixels;
 }
 
+// Mean milliseconds per call of each phase, as counters.
+struct PhaseSums {
+    RasterPhaseTimes sum;
+    void add(const RasterPhaseTimes& t) {
+        sum.project += t.project, sum.bin += t.bin, sum.gather += t.gather, sum.blend += t.blend;
+        sum.backward_tiles += t.backward_tiles, sum.reduce += t.reduce;
+    }
+    void report(benchmark::State& state, bool forward, bool backward) const {
+        const auto avg = [](double v) { return benchmark::Counter(v, benchmark::Counter::kAvgIterations); };
+        if (forward) {
+            state.counters["project_ms"] = avg(sum.project);
+            state.counters["bin_ms"] = avg(sum.bin);
+            state.counters["gather_ms"] = avg(sum.gather);
+            state.counters["blend_ms"] = avg(sum.blend);
+        }
+        if (backward) {
+            state.counters["bwd_tiles_ms"] = avg(sum.backward_tiles);
+            state.counters["reduce_ms"] = avg(sum.reduce);
+        }
+    }
+};
+
 void BM_Forward(benchmark::State& state) {
     const auto& f = fixture(int(state.range(0)), int(state.range(1)), int(state.range(2)));
     tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(3)));
     RasterState<float> st;
     RasterImages<float> img;
+    PhaseSums phases;
     for (auto _ : state) {
         rasterize_forward_cpu(f.cam, f.surfels, RasterSettings<float>{}, st, img);
         benchmark::DoNotOptimize(img.color.data());
+        phases.add(st.phase_ms);
     }
     set_counters(state, st, img);
+    phases.report(state, true, false);
 }
 
 void BM_Backward(benchmark::State& state) {
@@ -82,11 +107,14 @@ void BM_Backward(benchmark::State& state) {
     g.alpha.assign(img.alpha.size(), 0.01f);
     g.depth.assign(img.depth.size(), 0.001f);
     g.normal.assign(img.normal.size(), 0.01f);
+    PhaseSums phases;
     for (auto _ : state) {
         auto grads = rasterize_backward_cpu(f.surfels, st, g);
         benchmark::DoNotOptimize(grads.means.data());
+        phases.add(st.phase_ms);
     }
     set_counters(state, st, img);
+    phases.report(state, false, true);
 }
 
 void BM_ForwardBackward(benchmark::State& state) {

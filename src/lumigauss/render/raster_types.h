@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "lumigauss/io/camera.h"
+#include "lumigauss/render/cpu/radix_sort.h"
 #include "lumigauss/render/surfel_kernel.h"
 
 namespace lumigauss {
@@ -60,6 +61,33 @@ struct RasterSettings {
     std::vector<T> background;  // `channels` values; empty = black
 };
 
+// What the tiles and the binning read of a visible surfel besides its kernel geometry: its pixel box, its
+// camera-facing normal and its depth, compact (32 bytes in float) because they read it by surfel id.
+template <typename T>
+struct SplatFootprint {
+    raster::PixelRect rect;
+    Vec3<T> normal;
+    T depth;
+};
+
+// Tiles a surfel's box touches (inclusive).
+struct TileSpan {
+    int tx0, ty0, tx1, ty1;
+    std::uint32_t count() const { return std::uint32_t((tx1 - tx0 + 1) * (ty1 - ty0 + 1)); }
+};
+
+// What binning needs of a visible surfel, compact.
+struct VisibleSurfel {
+    TileSpan span;
+    std::uint32_t surfel, first_emission;
+};
+
+// Wall time of each phase of the last forward and backward, in milliseconds (for benchmarks and profiling).
+struct RasterPhaseTimes {
+    double project = 0, bin = 0, gather = 0, blend = 0;  // forward
+    double backward_tiles = 0, reduce = 0;               // backward
+};
+
 // What the forward keeps for the backward.
 template <typename T>
 struct RasterState {
@@ -67,16 +95,16 @@ struct RasterState {
     int tiles_x = 0, tiles_y = 0;
     std::vector<raster::ProjectedSurfel<T>> projected;
     std::vector<raster::SplatGeometry<T>> splats;  // per surfel: what the per-pixel kernel reads
+    std::vector<SplatFootprint<T>> footprints;     // per surfel: box, normal, depth
     std::vector<std::uint8_t> visible;
     std::vector<std::uint32_t> emission_offset;  // per surfel: first (surfel, tile) emission; size N + 1
     std::vector<std::uint32_t> tile_start;       // per tile: first sorted entry; size tiles + 1
     std::vector<std::uint32_t> entry_surfel;     // sorted entries: surfel id (per tile, front to back)
     std::vector<std::uint32_t> entry_emission;   // sorted entry -> its emission (slot of the backward)
-    // What the per-pixel loops read, gathered per sorted entry so tiles stream through memory instead of
-    // jumping between surfels: kernel geometry, pixel box and normal, and `channels` colours per entry.
+    // What the per-pixel loops read, gathered per sorted entry so that a tile's blocks stream through
+    // memory instead of jumping between surfels: kernel geometry, footprint, `channels` colours.
     std::vector<raster::SplatGeometry<T>> entry_splat;
-    std::vector<raster::PixelRect> entry_rect;
-    std::vector<Vec3<T>> entry_normal;
+    std::vector<SplatFootprint<T>> entry_footprint;
     std::vector<T> entry_color;
     // Per tile, per block of 4 x 2 pixels (the CPU backend's unit of work, render/cpu/tile_blocks.h): the
     // tile's entries, as indices from its first, that the forward composited into at least one of the
@@ -90,8 +118,11 @@ struct RasterState {
     std::vector<T> background;
 
     // Binning scratch, kept so that a loop reusing one RasterState does not allocate it again per call.
-    std::vector<std::uint64_t> sort_keys;
-    std::vector<std::uint32_t> emission_surfel;
+    std::vector<VisibleSurfel> visible_surfels;
+    std::vector<std::uint32_t> depth_keys, depth_order;  // visible_surfels indices, sorted front to back
+    RadixSortScratch sort_scratch;
+
+    mutable RasterPhaseTimes phase_ms;  // diagnostics only; the backward (const state) records its own
 
     std::size_t intersections() const { return entry_surfel.size(); }
 };

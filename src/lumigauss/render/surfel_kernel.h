@@ -83,7 +83,7 @@ LG_HD_INLINE L kernel_exp(L x) {
 // and float keeps its precision):
 //   k x l = dx (tv x tw) + dy (tw x tu) + (c.x tw - tu) x (c.y tw - tv) = dx pa + dy pb + pd,  d = pix - c.
 template <typename T>
-struct SplatGeometry {
+struct alignas(16 * sizeof(T)) SplatGeometry {  // 16 values: one 64-byte cache line in float
     Vec3<T> pa, pb, pd;
     Vec3<T> tw;
     Vec2<T> center;
@@ -91,9 +91,10 @@ struct SplatGeometry {
     T rho_cutoff;  // opacity * exp(-rho/2) < kAlphaMin beyond this
 };
 
+// `rho_cutoff` is reach_rho(opacity), which the projection has already computed (ProjectedSurfel::reach).
 template <typename T>
 LG_HD inline SplatGeometry<T> make_splat_geometry(Vec3<T> tu, Vec3<T> tv, Vec3<T> tw, Vec2<T> center,
-                                                  T opacity) {
+                                                  T opacity, T rho_cutoff) {
     SplatGeometry<T> g;
     g.pa = cross(tv, tw);
     g.pb = cross(tw, tu);
@@ -101,8 +102,13 @@ LG_HD inline SplatGeometry<T> make_splat_geometry(Vec3<T> tu, Vec3<T> tv, Vec3<T
     g.tw = tw;
     g.center = center;
     g.opacity = opacity;
-    g.rho_cutoff = reach_rho(opacity);
+    g.rho_cutoff = rho_cutoff;
     return g;
+}
+template <typename T>
+LG_HD inline SplatGeometry<T> make_splat_geometry(Vec3<T> tu, Vec3<T> tv, Vec3<T> tw, Vec2<T> center,
+                                                  T opacity) {
+    return make_splat_geometry(tu, tv, tw, center, opacity, reach_rho(opacity));
 }
 
 // Evaluates the surfel at pixel centre(s) (px, py). The result (true, or the lanes) says where the pair

@@ -37,6 +37,7 @@ struct ProjectedSurfel {
     Vec3<T> normal;      // world-space unit normal, flipped to face the camera
     T flip;              // +1 or -1: the flip applied to t_w
     T depth;             // view-space z of the mean: the sort key
+    T reach;             // reach_rho(opacity): rho beyond which alpha < kAlphaMin
     bool conic_center;   // true: centre of the dual-conic box; false: the disk crosses the camera plane
     PixelRect rect;
 };
@@ -99,6 +100,24 @@ LG_HD inline T reach_rho(T opacity) {
     return ratio > T(1) ? T(2) * std::log(ratio) * T(1.0001) + T(1e-6) : T(-1);
 }
 
+// True when a sphere (centre in camera space, squared radius) lies wholly in front of the near plane and
+// wholly beyond one side of the view frustum widened by `margin` pixels. A cheap test that spares most
+// off-screen surfels the exact projection below; it never rejects anything that exact bound would keep.
+template <typename T>
+LG_HD inline bool sphere_outside_view(Vec3<T> c, T radius_sq, T margin, const PinholeView<T>& view) {
+    const T front = c.z - T(kNearPlane);
+    if (!(front > T(0) && front * front > radius_sq)) return false;  // may reach the camera plane
+    // Each side is a plane through the camera centre, a.c >= 0 on the visible side (u >= -margin,
+    // u <= W + margin, and likewise for v). Beyond it by more than the radius: a.c < -r |a|.
+    const auto beyond = [&](T a_xy, T a_z, T xy) {
+        const T d = a_xy * xy + a_z * c.z;
+        return d < T(0) && d * d > radius_sq * (a_xy * a_xy + a_z * a_z);
+    };
+    return beyond(view.fx, view.cx + margin, c.x) ||
+           beyond(-view.fx, T(view.width) + margin - view.cx, c.x) ||
+           beyond(view.fy, view.cy + margin, c.y) || beyond(-view.fy, T(view.height) + margin - view.cy, c.y);
+}
+
 // Projects one surfel. Returns false when it cannot be seen (behind the near plane, exactly edge-on,
 // too transparent to ever reach kAlphaMin, degenerate, or off-screen).
 //
@@ -112,8 +131,16 @@ LG_HD inline bool project_surfel(const SurfelGeometry<T>& g, T opacity, const Pi
                                  ProjectedSurfel<T>& out) {
     const T reach = reach_rho(opacity);
     if (!(reach > T(0))) return false;
+    out.reach = reach;
     const Vec3<T> mean_cam = view.rotation * g.mean + view.translation;
     if (!(mean_cam.z > T(kNearPlane))) return false;
+    // Everything the surfel can reach: its disk out to rho = reach (or 3 sigma, which bounds the filter
+    // centre), then the screen filter's radius around that in pixels (plus one for rounding).
+    const T sigma = g.scale_u > g.scale_v ? g.scale_u : g.scale_v;
+    const T disk_sq =
+        (reach > T(kSigmaCutoff * kSigmaCutoff) ? reach : T(kSigmaCutoff * kSigmaCutoff)) * sigma * sigma;
+    if (sphere_outside_view(mean_cam, disk_sq, std::sqrt(reach / T(kFilterInvSquare)) + T(1), view))
+        return false;
     const Mat3<T> R = rotation_from_unit_quaternion(normalize_quaternion(g.quat));
     const Vec3<T> a = view.rotation * (g.scale_u * R.col(0));
     const Vec3<T> b = view.rotation * (g.scale_v * R.col(1));

@@ -29,7 +29,7 @@ void row_pairs(const RasterState<float>& st, int y, PixelPairs& out) {
         const float px = float(x) + 0.5f, py = float(y) + 0.5f;
         float t = 1.0f;
         for (std::uint32_t e = begin; e < end; ++e) {
-            const raster::PixelRect& r = st.entry_rect[e];
+            const raster::PixelRect& r = st.entry_footprint[e].rect;
             if (x < r.x0 || x > r.x1 || y < r.y0 || y > r.y1) continue;
             raster::SplatSample<float> s;
             if (!raster::evaluate_splat(st.entry_splat[e], px, py, s)) continue;

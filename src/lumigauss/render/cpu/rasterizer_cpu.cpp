@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <chrono>
 #include <memory>
 #include <string>
 
@@ -31,6 +32,7 @@ void project_all(const SurfelBatch<T>& surfels, RasterState<T>& st) {
     st.projected.resize(n);
     st.visible.assign(n, 0);
     st.splats.resize(n);
+    st.footprints.resize(n);
     const raster::PinholeView<double> view{st.view.rotation.template cast<double>(),
                                            st.view.translation.template cast<double>(),
                                            double(st.view.fx),
@@ -52,32 +54,40 @@ void project_all(const SurfelBatch<T>& surfels, RasterState<T>& st) {
             const bool ok = raster::project_surfel(gd, opacity, view, p);
             st.visible[i] = ok ? 1 : 0;
             if (!ok) continue;
-            const auto sg = raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, opacity);
+            const auto sg = raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, opacity, p.reach);
             st.projected[i] = {to<T>(p.tu),     to<T>(p.tv), to<T>(p.tw), {T(p.center.x), T(p.center.y)},
-                               to<T>(p.normal), T(p.flip),   T(p.depth),  p.conic_center,
-                               p.rect};
+                               to<T>(p.normal), T(p.flip),   T(p.depth),  T(p.reach),
+                               p.conic_center,  p.rect};
             st.splats[i] = {
                 to<T>(sg.pa),  to<T>(sg.pb),    to<T>(sg.pd), to<T>(sg.tw), {T(sg.center.x), T(sg.center.y)},
                 T(sg.opacity), T(sg.rho_cutoff)};
+            st.footprints[i] = {p.rect, to<T>(p.normal), T(p.depth)};
         }
     });
 }
 
-// Copies what the per-pixel loops read into sorted-entry order (see RasterState::entry_splat).
+// Copies what the per-pixel loops read into sorted-entry order (see RasterState::entry_splat). The surfels
+// of consecutive entries are scattered in memory: those a few entries ahead are asked for early, so that
+// the cache misses overlap instead of being waited for one by one.
+constexpr std::size_t kGatherAhead = 8;
 template <typename T>
 void gather_entries(const SurfelBatch<T>& surfels, RasterState<T>& st) {
     const std::size_t m = st.intersections();
     const int C = surfels.channels;
     st.entry_splat.resize(m);
-    st.entry_rect.resize(m);
-    st.entry_normal.resize(m);
+    st.entry_footprint.resize(m);
     st.entry_color.resize(m * std::size_t(C));
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 4096), [&](const auto& r) {
         for (std::size_t e = r.begin(); e != r.end(); ++e) {
+            if (e + kGatherAhead < r.end()) {
+                const std::uint32_t ahead = st.entry_surfel[e + kGatherAhead];
+                __builtin_prefetch(&st.splats[ahead]);
+                __builtin_prefetch(&st.footprints[ahead]);
+                __builtin_prefetch(&surfels.colors[std::size_t(ahead) * C]);
+            }
             const std::uint32_t id = st.entry_surfel[e];
             st.entry_splat[e] = st.splats[id];
-            st.entry_rect[e] = st.projected[id].rect;
-            st.entry_normal[e] = st.projected[id].normal;
+            st.entry_footprint[e] = st.footprints[id];
             std::copy_n(&surfels.colors[std::size_t(id) * C], C, &st.entry_color[e * C]);
         }
     });
@@ -93,6 +103,14 @@ void allocate_images(RasterImages<T>& img, int width, int height, int channels) 
     img.median_depth.resize(np);
     img.normal.resize(np * 3);
     img.distortion.resize(np);
+}
+
+// Milliseconds since `start`, and restarts it.
+double lap_ms(std::chrono::steady_clock::time_point& start) {
+    const auto now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - start).count();
+    start = now;
+    return ms;
 }
 
 void check_channels(int channels) {
@@ -162,9 +180,13 @@ void rasterize_forward_cpu(const Camera& camera, const SurfelBatch<T>& surfels,
     st.tiles_y = (camera.height + cpu::kTileSize - 1) / cpu::kTileSize;
     st.background = settings.background;
     check_channels(surfels.channels);
+    auto clock = std::chrono::steady_clock::now();
     project_all(surfels, st);
+    st.phase_ms.project = lap_ms(clock);
     bin_surfels_to_tiles(st);
+    st.phase_ms.bin = lap_ms(clock);
     gather_entries(surfels, st);
+    st.phase_ms.gather = lap_ms(clock);
 
     const std::size_t np = std::size_t(camera.width) * camera.height;
     st.final_transmittance.resize(np);
@@ -181,12 +203,14 @@ void rasterize_forward_cpu(const Camera& camera, const SurfelBatch<T>& surfels,
         cpu::TileScratch<T>& mine = scratch.local();
         for (int t = r.begin(); t != r.end(); ++t) cpu::forward_tile(t, surfels, st, img, mine);
     });
+    st.phase_ms.blend = lap_ms(clock);
 }
 
 template <typename T>
 SurfelGrads<T> rasterize_backward_cpu(const SurfelBatch<T>& surfels, const RasterState<T>& st,
                                       const RasterImageGrads<T>& grads) {
     check_channels(surfels.channels);
+    auto clock = std::chrono::steady_clock::now();
     const std::size_t n = surfels.size();
     const int stride = cpu::SlotLayout::stride(surfels.channels);
     // Every slot is written by its tile (zeros for entries no pixel reached), so no clearing here.
@@ -198,6 +222,7 @@ SurfelGrads<T> rasterize_backward_cpu(const SurfelBatch<T>& surfels, const Raste
         cpu::TileScratch<T>& mine = scratch.local();
         for (int t = r.begin(); t != r.end(); ++t) cpu::backward_tile(t, surfels, st, grads, slots, mine);
     });
+    st.phase_ms.backward_tiles = lap_ms(clock);
     SurfelGrads<T> out;
     out.means.assign(3 * n, T(0));
     out.quats.assign(4 * n, T(0));
@@ -206,6 +231,7 @@ SurfelGrads<T> rasterize_backward_cpu(const SurfelBatch<T>& surfels, const Raste
     out.colors.assign(n * surfels.channels, T(0));
     out.mean2d.assign(2 * n, T(0));
     reduce_surfel_gradients(surfels, st, slots, out);
+    st.phase_ms.reduce = lap_ms(clock);
     return out;
 }
 

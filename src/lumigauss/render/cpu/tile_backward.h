@@ -93,13 +93,14 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
             const std::uint32_t k = kept[n];
             const std::uint32_t e = begin + k;
             const raster::SplatGeometry<T>& geometry = st.entry_splat[e];
+            const SplatFootprint<T>& footprint = st.entry_footprint[e];
             raster::SplatSample<P> smp;
             const auto composited = raster::evaluate_splat(geometry, cx, cy, smp) &
-                                    lanes_in(st.entry_rect[e], px, py) &
+                                    lanes_in(footprint.rect, px, py) &
                                     (I(typename I::I(k + 1)) <= s.contributors);
             const P a = lane_select(composited, smp.alpha, P(0));
             const T* color = &st.entry_color[std::size_t(e) * channels];
-            const Vec3<T> normal = st.entry_normal[e];
+            const Vec3<T> normal = footprint.normal;
             const raster::BlendSampleGrad<P> bg =
                 raster::unblend_sample(s, a, smp.z, color, channels, normal, I(typename I::I(e)));
             const raster::SplatGradTerms<P> t =

@@ -4,7 +4,7 @@
 
 namespace lumigauss {
 
-// Fills st.emission_offset, st.tile_start, st.entry_surfel and st.entry_emission from st.projected,
+// Fills st.emission_offset, st.tile_start, st.entry_surfel and st.entry_emission from st.footprints,
 // st.visible, st.tiles_x and st.tiles_y.
 template <typename T>
 void bin_surfels_to_tiles(RasterState<T>& st);

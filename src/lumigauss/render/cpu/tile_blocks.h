@@ -66,7 +66,7 @@ void build_block_lists(const RasterState<T>& st, int tile, const raster::PixelRe
     const std::uint32_t begin = st.tile_start[tile], end = st.tile_start[tile + 1];
     std::uint32_t count[kTileBlocks] = {};
     for (std::uint32_t e = begin; e < end; ++e) {
-        const Span s = span_of(st.entry_rect[e]);
+        const Span s = span_of(st.entry_footprint[e].rect);
         for (int by = s.by0; by <= s.by1; ++by)
             for (int bx = s.bx0; bx <= s.bx1; ++bx) ++count[by * kBlocksX + bx];
     }
@@ -76,7 +76,7 @@ void build_block_lists(const RasterState<T>& st, int tile, const raster::PixelRe
     std::uint32_t cursor[kTileBlocks];
     std::copy_n(lists.start, kTileBlocks, cursor);
     for (std::uint32_t e = begin; e < end; ++e) {
-        const Span s = span_of(st.entry_rect[e]);
+        const Span s = span_of(st.entry_footprint[e].rect);
         for (int by = s.by0; by <= s.by1; ++by)
             for (int bx = s.bx0; bx <= s.bx1; ++bx) lists.items[cursor[by * kBlocksX + bx]++] = e - begin;
     }

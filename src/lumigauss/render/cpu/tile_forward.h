@@ -75,12 +75,13 @@ LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, RasterState<T>
         s.median_entry = I(-1);
         for (const std::uint32_t k : scratch.lists.block(b)) {
             const std::uint32_t e = begin + k;
+            const SplatFootprint<T>& footprint = st.entry_footprint[e];
             raster::SplatSample<P> smp;
             const auto hit =
-                raster::evaluate_splat(st.entry_splat[e], cx, cy, smp) & lanes_in(st.entry_rect[e], px, py);
+                raster::evaluate_splat(st.entry_splat[e], cx, cy, smp) & lanes_in(footprint.rect, px, py);
             const auto composited = raster::blend_sample(
                 s, lane_select(hit, smp.alpha, P(0)), smp.z, &st.entry_color[std::size_t(e) * channels],
-                channels, st.entry_normal[e], I(typename I::I(e)), I(typename I::I(k + 1)));
+                channels, footprint.normal, I(typename I::I(e)), I(typename I::I(k + 1)));
             const unsigned flags = any_of_each(composited, s.live > P(0));
             kept[num_kept] = k;
             num_kept += flags & 1;
