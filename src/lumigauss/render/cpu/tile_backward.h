@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/render/cpu/tile_forward.h"
 
 namespace lumigauss::cpu {
@@ -17,9 +18,9 @@ namespace lumigauss::cpu {
 struct SlotLayout {
     static constexpr int kPa = 0, kPb = 3, kPd = 6, kTw = 9, kCenter = 12, kNormal = 14, kOpacity = 17,
                          kColor = 18;
-    static constexpr int stride(int channels) { return kColor + channels; }
-    // The per-tile sums are kept in whole packs.
-    static constexpr int padded(int channels) { return (stride(channels) + kLanes - 1) / kLanes * kLanes; }
+    static constexpr int values(int channels) { return kColor + channels; }
+    // Slots are whole packs (the padding holds zeros), so that they are summed and copied as packs.
+    static constexpr int stride(int channels) { return (values(channels) + kLanes - 1) / kLanes * kLanes; }
 };
 
 template <typename T>
@@ -74,8 +75,8 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
                                            const RasterImageGrads<T>& g, T* slots, TileScratch<T>& scratch) {
     using P = Pack8<T>;
     using I = Int8<T>;
-    constexpr int kPadded = SlotLayout::padded(C);
-    const int stride = SlotLayout::stride(channels);
+    constexpr int kPadded = SlotLayout::stride(C);
+    const int stride = SlotLayout::stride(channels);  // kPadded, but for the general path
     const raster::PixelRect tr = tile_pixels(tile, st.tiles_x, st.view.width, st.view.height);
     const std::uint32_t begin = st.tile_start[tile], count = st.tile_start[tile + 1] - begin;
     scratch.grads.assign(std::size_t(count) * kPadded, T(0));
@@ -118,14 +119,17 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
             q[SlotLayout::kCenter + 1] = t.g_center.y;
             q[SlotLayout::kOpacity] = t.g_opacity;
             for (int c = 0; c < C; ++c) q[SlotLayout::kColor + c] = bg.w * s.g_color[c];
-            for (int j = SlotLayout::stride(C); j < kPadded; ++j) q[j] = P(T(0));
+            for (int j = SlotLayout::values(C); j < kPadded; ++j) q[j] = P(T(0));
             add_lane_sums<kPadded>(q, &scratch.grads[std::size_t(k) * kPadded]);
         }
     }
     // Slots are indexed by emission (contiguous per surfel) so the per-surfel reduction streams.
-    for (std::uint32_t k = 0; k < count; ++k)
-        std::copy_n(&scratch.grads[std::size_t(k) * kPadded], stride,
-                    &slots[std::size_t(st.entry_emission[begin + k]) * stride]);
+    for (std::uint32_t k = 0; k < count; ++k) {
+        const T* from = &scratch.grads[std::size_t(k) * kPadded];
+        T* to = &slots[std::size_t(st.entry_emission[begin + k]) * stride];
+        for (int j = 0; j < (C == kMaxChannels ? stride : kPadded); j += kLanes)  // fixed length for 3 and 6
+            store_pack(to + j, load_pack(from + j));
+    }
 }
 
 }  // namespace lumigauss::cpu
