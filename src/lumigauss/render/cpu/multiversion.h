@@ -7,3 +7,10 @@
 #else
 #define LG_MULTIVERSION
 #endif
+// With LG_MULTIVERSION on a function whose callees are not force-inlined: inline them all into each
+// version (a call out of a clone runs the baseline version of the callee).
+#if defined(__GNUC__) && !defined(__clang__)
+#define LG_FLATTEN __attribute__((flatten))
+#else
+#define LG_FLATTEN
+#endif

@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "lumigauss/render/cpu/multiversion.h"
 #include "lumigauss/render/cpu/tile_backward.h"
 #include "lumigauss/render/cpu/tile_binning.h"
 #include "lumigauss/render/cpu/tile_kernels.h"
@@ -27,6 +28,45 @@ Vec3<T> to(Vec3<double> v) {
 // The per-surfel set-up runs in double whatever T is: it is cheap next to the per-pixel work, and the
 // kernel's coefficients (differences of nearly equal products) keep their precision when rounded to float.
 template <typename T>
+LG_ALWAYS_INLINE void project_range(const SurfelBatch<T>& surfels, RasterState<T>& st,
+                                    const raster::PinholeView<double>& view, std::size_t begin,
+                                    std::size_t end) {
+    for (std::size_t i = begin; i != end; ++i) {
+        const double opacity = double(surfels.opacities[i]);
+        const auto g = surfels.geometry(i);
+        const raster::SurfelGeometry<double> gd{
+            g.mean.template cast<double>(),
+            {double(g.quat.x), double(g.quat.y), double(g.quat.z), double(g.quat.w)},
+            double(g.scale_u),
+            double(g.scale_v)};
+        ProjectedSurfel<double> p;
+        const bool ok = raster::project_surfel(gd, opacity, view, p);
+        st.visible[i] = ok ? 1 : 0;
+        if (!ok) continue;
+        const auto sg = raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, opacity, p.reach);
+        st.projected[i] = {to<T>(p.tu),     to<T>(p.tv), to<T>(p.tw), {T(p.center.x), T(p.center.y)},
+                           to<T>(p.normal), T(p.flip),   T(p.depth),  T(p.reach),
+                           p.conic_center,  p.rect};
+        st.splats[i] = {
+            to<T>(sg.pa),  to<T>(sg.pb),    to<T>(sg.pd), to<T>(sg.tw), {T(sg.center.x), T(sg.center.y)},
+            T(sg.opacity), T(sg.rho_cutoff)};
+        st.footprints[i] = {p.rect, to<T>(p.normal), T(p.depth)};
+    }
+}
+
+// Compiled per instruction set like the tile kernels (FMA, and rounding instructions for the pixel box
+// instead of libm calls), with everything it calls inlined into each version.
+LG_FLATTEN LG_MULTIVERSION void project_surfels(const SurfelBatch<float>& surfels, RasterState<float>& st,
+                                                const raster::PinholeView<double>& view, std::size_t begin,
+                                                std::size_t end) {
+    project_range(surfels, st, view, begin, end);
+}
+void project_surfels(const SurfelBatch<double>& surfels, RasterState<double>& st,
+                     const raster::PinholeView<double>& view, std::size_t begin, std::size_t end) {
+    project_range(surfels, st, view, begin, end);
+}
+
+template <typename T>
 void project_all(const SurfelBatch<T>& surfels, RasterState<T>& st) {
     const std::size_t n = surfels.size();
     st.projected.resize(n);
@@ -41,29 +81,8 @@ void project_all(const SurfelBatch<T>& surfels, RasterState<T>& st) {
                                            double(st.view.cy),
                                            st.view.width,
                                            st.view.height};
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const double opacity = double(surfels.opacities[i]);
-            const auto g = surfels.geometry(i);
-            const raster::SurfelGeometry<double> gd{
-                g.mean.template cast<double>(),
-                {double(g.quat.x), double(g.quat.y), double(g.quat.z), double(g.quat.w)},
-                double(g.scale_u),
-                double(g.scale_v)};
-            ProjectedSurfel<double> p;
-            const bool ok = raster::project_surfel(gd, opacity, view, p);
-            st.visible[i] = ok ? 1 : 0;
-            if (!ok) continue;
-            const auto sg = raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, opacity, p.reach);
-            st.projected[i] = {to<T>(p.tu),     to<T>(p.tv), to<T>(p.tw), {T(p.center.x), T(p.center.y)},
-                               to<T>(p.normal), T(p.flip),   T(p.depth),  T(p.reach),
-                               p.conic_center,  p.rect};
-            st.splats[i] = {
-                to<T>(sg.pa),  to<T>(sg.pb),    to<T>(sg.pd), to<T>(sg.tw), {T(sg.center.x), T(sg.center.y)},
-                T(sg.opacity), T(sg.rho_cutoff)};
-            st.footprints[i] = {p.rect, to<T>(p.normal), T(p.depth)};
-        }
-    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
+                      [&](const auto& r) { project_surfels(surfels, st, view, r.begin(), r.end()); });
 }
 
 // Copies what the per-pixel loops read into sorted-entry order (see RasterState::entry_splat). The surfels
@@ -119,46 +138,63 @@ void check_channels(int channels) {
                     " colour channels, not " + std::to_string(channels));
 }
 
+// Per visible surfel: sums its (surfel, tile) slots and runs the projection backward.
+template <typename T>
+LG_ALWAYS_INLINE void reduce_range(const SurfelBatch<T>& surfels, const RasterState<T>& st, const T* slots,
+                                   SurfelGrads<T>& out, std::size_t begin, std::size_t end) {
+    const int C = surfels.channels;
+    const int stride = cpu::SlotLayout::stride(C);  // a multiple of the pack width
+    alignas(64) T sum[cpu::SlotLayout::stride(kMaxChannels)];
+    for (std::size_t i = begin; i != end; ++i) {
+        if (!st.visible[i]) continue;
+        std::fill_n(sum, stride, T(0));
+        for (std::uint32_t em = st.emission_offset[i]; em < st.emission_offset[i + 1]; ++em) {
+            const T* slot = &slots[std::size_t(em) * stride];
+            for (int k = 0; k < stride; ++k) sum[k] += slot[k];
+        }
+        raster::SplatGrad<T> sg;
+        raster::ProjectedSurfelGrad<T> pg{};
+        for (int k = 0; k < 3; ++k) {
+            sg.pa[k] = sum[cpu::SlotLayout::kPa + k];
+            sg.pb[k] = sum[cpu::SlotLayout::kPb + k];
+            sg.pd[k] = sum[cpu::SlotLayout::kPd + k];
+            sg.tw[k] = sum[cpu::SlotLayout::kTw + k];
+            pg.normal[k] = sum[cpu::SlotLayout::kNormal + k];
+        }
+        sg.center = {sum[cpu::SlotLayout::kCenter], sum[cpu::SlotLayout::kCenter + 1]};
+        sg.opacity = sum[cpu::SlotLayout::kOpacity];
+        const ProjectedSurfel<T>& ps = st.projected[i];
+        T g_opacity = 0;
+        raster::to_ray_transform_grad(ps.tu, ps.tv, ps.tw, ps.center, sg, pg, g_opacity);
+        // Screen-space gradient for densification: a translation by delta pixels adds delta * tw.z to
+        // the third column of rows tu and tv. Like the reference, it leaves out the low-pass branch.
+        out.mean2d[2 * i] = pg.tu.z * ps.tw.z;
+        out.mean2d[2 * i + 1] = pg.tv.z * ps.tw.z;
+        const auto gg = raster::project_surfel_vjp(surfels.geometry(i), st.view, ps, pg);
+        for (int k = 0; k < 3; ++k) out.means[3 * i + k] = gg.mean[k];
+        for (int k = 0; k < 4; ++k) out.quats[4 * i + k] = gg.quat[k];
+        out.scales[2 * i] = gg.scale_u;
+        out.scales[2 * i + 1] = gg.scale_v;
+        out.opacities[i] = g_opacity;
+        for (int c = 0; c < C; ++c) out.colors[i * C + c] = sum[cpu::SlotLayout::kColor + c];
+    }
+}
+
+LG_FLATTEN LG_MULTIVERSION void reduce_surfels(const SurfelBatch<float>& surfels,
+                                               const RasterState<float>& st, const float* slots,
+                                               SurfelGrads<float>& out, std::size_t begin, std::size_t end) {
+    reduce_range(surfels, st, slots, out, begin, end);
+}
+void reduce_surfels(const SurfelBatch<double>& surfels, const RasterState<double>& st, const double* slots,
+                    SurfelGrads<double>& out, std::size_t begin, std::size_t end) {
+    reduce_range(surfels, st, slots, out, begin, end);
+}
+
 template <typename T>
 void reduce_surfel_gradients(const SurfelBatch<T>& surfels, const RasterState<T>& st, const T* slots,
                              SurfelGrads<T>& out) {
-    const int C = surfels.channels;
-    const int stride = cpu::SlotLayout::stride(C);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, surfels.size(), 256), [&](const auto& range) {
-        std::vector<T> sum(stride);
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-            if (!st.visible[i]) continue;
-            std::fill(sum.begin(), sum.end(), T(0));
-            for (std::uint32_t em = st.emission_offset[i]; em < st.emission_offset[i + 1]; ++em) {
-                const T* slot = &slots[std::size_t(em) * stride];
-                for (int k = 0; k < stride; ++k) sum[k] += slot[k];
-            }
-            raster::SplatGrad<T> sg;
-            raster::ProjectedSurfelGrad<T> pg{};
-            for (int k = 0; k < 3; ++k) {
-                sg.pa[k] = sum[cpu::SlotLayout::kPa + k];
-                sg.pb[k] = sum[cpu::SlotLayout::kPb + k];
-                sg.pd[k] = sum[cpu::SlotLayout::kPd + k];
-                sg.tw[k] = sum[cpu::SlotLayout::kTw + k];
-                pg.normal[k] = sum[cpu::SlotLayout::kNormal + k];
-            }
-            sg.center = {sum[cpu::SlotLayout::kCenter], sum[cpu::SlotLayout::kCenter + 1]};
-            sg.opacity = sum[cpu::SlotLayout::kOpacity];
-            const ProjectedSurfel<T>& ps = st.projected[i];
-            T g_opacity = 0;
-            raster::to_ray_transform_grad(ps.tu, ps.tv, ps.tw, ps.center, sg, pg, g_opacity);
-            // Screen-space gradient for densification: a translation by delta pixels adds delta * tw.z to
-            // the third column of rows tu and tv. Like the reference, it leaves out the low-pass branch.
-            out.mean2d[2 * i] = pg.tu.z * ps.tw.z;
-            out.mean2d[2 * i + 1] = pg.tv.z * ps.tw.z;
-            const auto gg = raster::project_surfel_vjp(surfels.geometry(i), st.view, ps, pg);
-            for (int k = 0; k < 3; ++k) out.means[3 * i + k] = gg.mean[k];
-            for (int k = 0; k < 4; ++k) out.quats[4 * i + k] = gg.quat[k];
-            out.scales[2 * i] = gg.scale_u;
-            out.scales[2 * i + 1] = gg.scale_v;
-            out.opacities[i] = g_opacity;
-            for (int c = 0; c < C; ++c) out.colors[i * C + c] = sum[cpu::SlotLayout::kColor + c];
-        }
+        reduce_surfels(surfels, st, slots, out, range.begin(), range.end());
     });
 }
 
