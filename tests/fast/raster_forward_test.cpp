@@ -305,6 +305,51 @@ TEST(RasterProjection, BoundingBoxHoldsEveryContributingPixel) {
     EXPECT_GT(contributing, 1000);
 }
 
+TEST(RasterProjection, OffScreenCullNeverDropsAContributingSurfel) {
+    // project_surfel rejects surfels whose reachable sphere lies beyond a side of the view before computing
+    // the exact box. Surfels are scattered in a band around the image, large and small, every opacity;
+    // each is also projected into a view 200 pixels wider on every side (the same camera, cx and cy
+    // shifted), where nothing is culled, and evaluated densely on the original image's pixels. Whenever
+    // one of those pixels reaches alpha 1/255 there, the original view must keep the surfel.
+    const Camera cam = test_camera(48, 40);
+    Camera wide = cam;
+    const int pad = 200;
+    wide.width += 2 * pad, wide.height += 2 * pad, wide.cx += pad, wide.cy += pad;
+    const auto view = pinhole_view<double>(cam), wide_view = pinhole_view<double>(wide);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> uni(0, 1);
+    int culled = 0, contributing = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const double z = 1.0 + 8 * uni(rng);
+        // Centres within +-60 % of the image size beyond its edges.
+        const double px = (uni(rng) * 2.2 - 0.6) * cam.width, py = (uni(rng) * 2.2 - 0.6) * cam.height;
+        const double opacity = std::exp(std::log(1.0 / 250) * uni(rng));
+        const double scale = std::exp(std::log(0.002) + (std::log(2.0) - std::log(0.002)) * uni(rng));
+        auto s = one_surfel(cam, {(px - cam.cx) / cam.fx * z, (py - cam.cy) / cam.fy * z, z}, scale, opacity);
+        if (i % 2) {  // half tilted at random and elongated, half facing the camera (the tightest case)
+            for (int k = 0; k < 4; ++k) s.quats[std::size_t(k)] = uni(rng) - 0.5;
+            s.scales[1] = scale * (0.2 + uni(rng));
+        }
+        raster::ProjectedSurfel<double> p, pw;
+        const bool kept = raster::project_surfel(s.geometry(0), opacity, view, p);
+        if (!raster::project_surfel(s.geometry(0), opacity, wide_view, pw)) continue;
+        const auto g = raster::make_splat_geometry(pw.tu, pw.tv, pw.tw, pw.center, opacity);
+        bool reaches = false;
+        for (int y = 0; y < cam.height && !reaches; ++y)
+            for (int x = 0; x < cam.width && !reaches; ++x) {
+                raster::SplatSample<double> smp;
+                reaches = raster::evaluate_splat(g, x + pad + 0.5, y + pad + 0.5, smp);
+            }
+        contributing += reaches;
+        culled += !kept;
+        if (reaches) {
+            EXPECT_TRUE(kept) << "surfel " << i << " reaches the image but was culled";
+        }
+    }
+    EXPECT_GT(contributing, 300);  // the test sees both kinds in numbers
+    EXPECT_GT(culled, 300);
+}
+
 TEST(RasterProjection, TooTransparentSurfelsAreCulled) {
     const Camera cam = test_camera();
     raster::ProjectedSurfel<double> p;
