@@ -108,8 +108,9 @@ void BM_Backward(benchmark::State& state) {
     g.depth.assign(img.depth.size(), 0.001f);
     g.normal.assign(img.normal.size(), 0.01f);
     PhaseSums phases;
+    SurfelGrads<float> grads;
     for (auto _ : state) {
-        auto grads = rasterize_backward_cpu(f.surfels, st, g);
+        rasterize_backward_cpu(f.surfels, st, g, grads);
         benchmark::DoNotOptimize(grads.means.data());
         phases.add(st.phase_ms);
     }
@@ -123,11 +124,12 @@ void BM_ForwardBackward(benchmark::State& state) {
     RasterState<float> st;
     RasterImages<float> img;
     RasterImageGrads<float> g;
+    SurfelGrads<float> grads;
     for (auto _ : state) {
         rasterize_forward_cpu(f.cam, f.surfels, RasterSettings<float>{}, st, img);
         g.color.assign(img.color.size(), 0.01f);
         g.alpha.assign(img.alpha.size(), 0.01f);
-        auto grads = rasterize_backward_cpu(f.surfels, st, g);
+        rasterize_backward_cpu(f.surfels, st, g, grads);
         benchmark::DoNotOptimize(grads.means.data());
     }
     set_counters(state, st, img);

@@ -109,15 +109,15 @@ LG_HD_INLINE BlendSampleGrad<L> unblend_sample(BlendPixelBackward<L, C>& s, L a,
     }
     for (int k = 0; k < 3; ++k) g_alpha_inner += (L(normal[k]) - s.acc_normal[k]) * s.g_normal[k];
     const L z = lane_select(composited, z_sample, L(1));
-    const L m = distortion_depth(z);
+    const DistortionDepth<L> mapped = distortion_depth_and_derivative(z);
+    const L m = mapped.m;
     const L dist_w = (m * m * s.a_total + s.m2 - L(2) * m * s.m1) * s.g_dist;  // dL/dw of the distortion
     g_alpha_inner += (z - s.acc_z) * s.g_depth + (L(1) - s.acc_alpha) * s.g_alpha + dist_w - s.acc_dist;
     BlendSampleGrad<L> out;
     out.w = w;
     out.g_alpha = lane_select(composited, t_before * g_alpha_inner - s.bg_term / one_minus_a, L(0));
     const L g_median = lane_select(s.median_entry == entry, s.g_median, L(0));
-    const L g_z = w * s.g_depth + g_median +
-                  L(2) * w * (m * s.a_total - s.m1) * s.g_dist * distortion_depth_derivative(z);
+    const L g_z = w * s.g_depth + g_median + L(2) * w * (m * s.a_total - s.m1) * s.g_dist * mapped.dm_dz;
     out.g_z = lane_select(composited, g_z, L(0));
 
     // Fold this sample into the "behind" blends of the sample in front of it.

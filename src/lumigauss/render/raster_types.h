@@ -117,6 +117,9 @@ struct RasterState {
     std::vector<T> m1, m2;                    // per pixel: sum w m, sum w m^2 (distortion)
     std::vector<T> background;
 
+    // The backward's (surfel, tile) gradient slots, kept like the binning scratch below.
+    std::vector<T> gradient_slots;
+
     // Binning scratch, kept so that a loop reusing one RasterState does not allocate it again per call.
     std::vector<VisibleSurfel> visible_surfels;
     std::vector<std::uint32_t> depth_keys, depth_order;  // visible_surfels indices, sorted front to back

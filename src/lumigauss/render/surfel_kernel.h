@@ -49,6 +49,7 @@ struct SplatSample {
     L alpha{};                    // min(kAlphaMax, opacity * gauss)
     L gauss{};                    // max of the object-space Gaussian and the screen-space filter
     L u{}, v{};                   // intersection in the surfel's (u, v) frame (object branch only)
+    L inv_pz{};                   // 1 / p.z of the homogeneous hit (the backward reuses it)
     L z{};                        // depth of this contribution
     LaneMask<L> screen_branch{};  // the screen low-pass filter won
     LaneMask<L> clamped{};        // alpha hit kAlphaMax
@@ -121,9 +122,9 @@ LG_HD_INLINE LaneMask<L> evaluate_splat(const SplatGeometry<T>& g, L px, L py, S
     const L p_x = dx * L(g.pa.x) + dy * L(g.pb.x) + L(g.pd.x);
     const L p_y = dx * L(g.pa.y) + dy * L(g.pb.y) + L(g.pd.y);
     const L p_z = dx * L(g.pa.z) + dy * L(g.pb.z) + L(g.pd.z);
-    const L inv_pz = L(1) / p_z;
-    s.u = p_x * inv_pz;
-    s.v = p_y * inv_pz;
+    s.inv_pz = L(1) / p_z;
+    s.u = p_x * s.inv_pz;
+    s.v = p_y * s.inv_pz;
     const L rho_object = s.u * s.u + s.v * s.v;
     const L rho_screen = L(kFilterInvSquare) * (dx * dx + dy * dy);
     s.screen_branch = rho_screen < rho_object;
@@ -163,27 +164,27 @@ struct SplatGradTerms {
 
 // Branch-free: both filter branches computed, one selected, and every value of the branch not taken
 // zeroed before it can become inf * 0. `screen_branch` may also be set for pixels the pair does not
-// reach: with g_alpha = g_z = 0 there, every term is then exactly 0 whatever u, v and p.z are.
+// reach: with g_alpha = g_z = 0 there, every term is then exactly 0 whatever u, v and p.z are. `smp` is
+// what evaluate_splat returned for the same pixel.
 template <typename T, typename L>
-LG_HD_INLINE SplatGradTerms<L> splat_grad_terms(const SplatGeometry<T>& g, L px, L py, L sample_u, L sample_v,
-                                                L gauss, LaneMask<L> screen_branch, LaneMask<L> clamped,
+LG_HD_INLINE SplatGradTerms<L> splat_grad_terms(const SplatGeometry<T>& g, L px, L py,
+                                                const SplatSample<L>& smp, LaneMask<L> screen_branch,
                                                 L g_alpha, L g_z) {
     SplatGradTerms<L> t;
     // The alpha clamp is differentiated exactly: no gradient through a clamped alpha.
-    const L ga = lane_select(clamped, L(0), g_alpha);
-    t.g_opacity = gauss * ga;
+    const L ga = lane_select(smp.clamped, L(0), g_alpha);
+    t.g_opacity = smp.gauss * ga;
     const L g_gauss = L(g.opacity) * ga;
     t.dx = px - L(g.center.x);
     t.dy = py - L(g.center.y);
     // Screen branch: gauss = exp(-|pix - c|^2), so d gauss / d c = 2 (pix - c) gauss; z = tw.z.
-    const L k2 = lane_select(screen_branch, L(kFilterInvSquare) * gauss * g_gauss, L(0));
+    const L k2 = lane_select(screen_branch, L(kFilterInvSquare) * smp.gauss * g_gauss, L(0));
     t.g_center = {k2 * t.dx, k2 * t.dy};
     // Object branch: gauss = exp(-(u^2 + v^2) / 2), z = tw . (u, v, 1), (u, v) = (p.x, p.y) / p.z.
-    const L u = lane_select(screen_branch, L(0), sample_u), v = lane_select(screen_branch, L(0), sample_v);
-    const L g_u = -u * gauss * g_gauss + lane_select(screen_branch, L(0), g_z * L(g.tw.x));
-    const L g_v = -v * gauss * g_gauss + lane_select(screen_branch, L(0), g_z * L(g.tw.y));
-    const L p_z = t.dx * L(g.pa.z) + t.dy * L(g.pb.z) + L(g.pd.z);
-    const L inv_pz = lane_select(screen_branch, L(0), L(1) / p_z);
+    const L u = lane_select(screen_branch, L(0), smp.u), v = lane_select(screen_branch, L(0), smp.v);
+    const L g_u = -u * smp.gauss * g_gauss + lane_select(screen_branch, L(0), g_z * L(g.tw.x));
+    const L g_v = -v * smp.gauss * g_gauss + lane_select(screen_branch, L(0), g_z * L(g.tw.y));
+    const L inv_pz = lane_select(screen_branch, L(0), smp.inv_pz);
     t.g_p = {g_u * inv_pz, g_v * inv_pz, -(g_u * u + g_v * v) * inv_pz};
     t.g_tw = {g_z * u, g_z * v, g_z};
     return t;
@@ -210,10 +211,17 @@ LG_HD_INLINE T distortion_depth(T z) {
     const T n = T(kNearPlane), f = T(kFarPlane);
     return f / (f - n) * (T(1) - n / z);
 }
+// m and dm/dz = f n / ((f - n) z^2) from one reciprocal (the backward needs both).
 template <typename T>
-LG_HD_INLINE T distortion_depth_derivative(T z) {
-    const T n = T(kNearPlane), f = T(kFarPlane);
-    return f * n / ((f - n) * z * z);
+struct DistortionDepth {
+    T m, dm_dz;
+};
+template <typename T>
+LG_HD_INLINE DistortionDepth<T> distortion_depth_and_derivative(T z) {
+    using S = lane_scalar_t<T>;
+    const S n = S(kNearPlane), f = S(kFarPlane);
+    const T inv_z = T(S(1)) / z;
+    return {T(f / (f - n)) * (T(S(1)) - T(n) * inv_z), T(f * n / (f - n)) * inv_z * inv_z};
 }
 
 }  // namespace lumigauss::raster

@@ -137,6 +137,7 @@ struct Trainer::Scratch {
     RasterState<float> raster;
     RasterImages<float> images;
     RasterImageGrads<float> image_grads;
+    SurfelGrads<float> surfel_grads;
     std::vector<float> rendered, grad_rendered, radii, mean2d;
     RasterSettings<float> settings;
 };
@@ -306,7 +307,8 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     times_.losses += seconds_since(t0);
 
     t0 = Clock::now();
-    const SurfelGrads<float> sg = rasterize_backward_cpu(s.batch, s.raster, g);
+    rasterize_backward_cpu(s.batch, s.raster, g, s.surfel_grads);
+    const SurfelGrads<float>& sg = s.surfel_grads;
     times_.raster_backward += seconds_since(t0);
 
     t0 = Clock::now();

@@ -138,7 +138,17 @@ void check_channels(int channels) {
                     " colour channels, not " + std::to_string(channels));
 }
 
-// Per visible surfel: sums its (surfel, tile) slots and runs the projection backward.
+template <typename T>
+LG_ALWAYS_INLINE void write_zero_gradients(SurfelGrads<T>& out, std::size_t i, int channels) {
+    std::fill_n(&out.means[3 * i], 3, T(0));
+    std::fill_n(&out.quats[4 * i], 4, T(0));
+    std::fill_n(&out.scales[2 * i], 2, T(0));
+    out.opacities[i] = T(0);
+    std::fill_n(&out.colors[i * channels], channels, T(0));
+    std::fill_n(&out.mean2d[2 * i], 2, T(0));
+}
+
+// Per surfel: sums its (surfel, tile) slots and runs the projection backward (zeros for the invisible).
 template <typename T>
 LG_ALWAYS_INLINE void reduce_range(const SurfelBatch<T>& surfels, const RasterState<T>& st, const T* slots,
                                    SurfelGrads<T>& out, std::size_t begin, std::size_t end) {
@@ -146,7 +156,10 @@ LG_ALWAYS_INLINE void reduce_range(const SurfelBatch<T>& surfels, const RasterSt
     const int stride = cpu::SlotLayout::stride(C);  // a multiple of the pack width
     alignas(64) T sum[cpu::SlotLayout::stride(kMaxChannels)];
     for (std::size_t i = begin; i != end; ++i) {
-        if (!st.visible[i]) continue;
+        if (!st.visible[i]) {
+            write_zero_gradients(out, i, C);
+            continue;
+        }
         std::fill_n(sum, stride, T(0));
         for (std::uint32_t em = st.emission_offset[i]; em < st.emission_offset[i + 1]; ++em) {
             const T* slot = &slots[std::size_t(em) * stride];
@@ -242,16 +255,18 @@ void rasterize_forward_cpu(const Camera& camera, const SurfelBatch<T>& surfels,
     st.phase_ms.blend = lap_ms(clock);
 }
 
+namespace {
+
 template <typename T>
-SurfelGrads<T> rasterize_backward_cpu(const SurfelBatch<T>& surfels, const RasterState<T>& st,
-                                      const RasterImageGrads<T>& grads) {
+void backward_into(const SurfelBatch<T>& surfels, const RasterState<T>& st, const RasterImageGrads<T>& grads,
+                   std::vector<T>& slot_buffer, SurfelGrads<T>& out) {
     check_channels(surfels.channels);
     auto clock = std::chrono::steady_clock::now();
     const std::size_t n = surfels.size();
     const int stride = cpu::SlotLayout::stride(surfels.channels);
     // Every slot is written by its tile (zeros for entries no pixel reached), so no clearing here.
-    const std::unique_ptr<T[]> slot_buffer(new T[st.intersections() * std::size_t(stride)]);
-    T* slots = slot_buffer.get();
+    slot_buffer.resize(st.intersections() * std::size_t(stride));
+    T* slots = slot_buffer.data();
     const int num_tiles = st.tiles_x * st.tiles_y;
     tbb::enumerable_thread_specific<cpu::TileScratch<T>> scratch;
     tbb::parallel_for(tbb::blocked_range<int>(0, num_tiles, 1), [&](const auto& r) {
@@ -259,16 +274,32 @@ SurfelGrads<T> rasterize_backward_cpu(const SurfelBatch<T>& surfels, const Raste
         for (int t = r.begin(); t != r.end(); ++t) cpu::backward_tile(t, surfels, st, grads, slots, mine);
     });
     st.phase_ms.backward_tiles = lap_ms(clock);
-    SurfelGrads<T> out;
-    out.means.assign(3 * n, T(0));
-    out.quats.assign(4 * n, T(0));
-    out.scales.assign(2 * n, T(0));
-    out.opacities.assign(n, T(0));
-    out.colors.assign(n * surfels.channels, T(0));
-    out.mean2d.assign(2 * n, T(0));
+    // Every entry is written by the reduction (zeros for invisible surfels).
+    out.means.resize(3 * n);
+    out.quats.resize(4 * n);
+    out.scales.resize(2 * n);
+    out.opacities.resize(n);
+    out.colors.resize(n * surfels.channels);
+    out.mean2d.resize(2 * n);
     reduce_surfel_gradients(surfels, st, slots, out);
     st.phase_ms.reduce = lap_ms(clock);
+}
+
+}  // namespace
+
+template <typename T>
+SurfelGrads<T> rasterize_backward_cpu(const SurfelBatch<T>& surfels, const RasterState<T>& st,
+                                      const RasterImageGrads<T>& grads) {
+    std::vector<T> slots;
+    SurfelGrads<T> out;
+    backward_into(surfels, st, grads, slots, out);
     return out;
+}
+
+template <typename T>
+void rasterize_backward_cpu(const SurfelBatch<T>& surfels, RasterState<T>& st,
+                            const RasterImageGrads<T>& grads, SurfelGrads<T>& out) {
+    backward_into(surfels, st, grads, st.gradient_slots, out);
 }
 
 template RasterImages<float> rasterize_forward_cpu(const Camera&, const SurfelBatch<float>&,
@@ -283,5 +314,9 @@ template SurfelGrads<float> rasterize_backward_cpu(const SurfelBatch<float>&, co
                                                    const RasterImageGrads<float>&);
 template SurfelGrads<double> rasterize_backward_cpu(const SurfelBatch<double>&, const RasterState<double>&,
                                                     const RasterImageGrads<double>&);
+template void rasterize_backward_cpu(const SurfelBatch<float>&, RasterState<float>&,
+                                     const RasterImageGrads<float>&, SurfelGrads<float>&);
+template void rasterize_backward_cpu(const SurfelBatch<double>&, RasterState<double>&,
+                                     const RasterImageGrads<double>&, SurfelGrads<double>&);
 
 }  // namespace lumigauss

@@ -26,4 +26,10 @@ template <typename T>
 SurfelGrads<T> rasterize_backward_cpu(const SurfelBatch<T>& surfels, const RasterState<T>& state,
                                       const RasterImageGrads<T>& grads);
 
+// The same, into caller-owned gradients, with the state's scratch: no allocation from call to call once
+// the buffers have grown (training loops).
+template <typename T>
+void rasterize_backward_cpu(const SurfelBatch<T>& surfels, RasterState<T>& state,
+                            const RasterImageGrads<T>& grads, SurfelGrads<T>& out);
+
 }  // namespace lumigauss

@@ -93,6 +93,8 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
         for (std::uint32_t n = kept_start[b + 1]; n-- > kept_start[b];) {
             const std::uint32_t k = kept[n];
             const std::uint32_t e = begin + k;
+            if (n >= kept_start[b] + kPrefetchAhead)
+                prefetch_entry(st, begin + kept[n - kPrefetchAhead], channels);
             const raster::SplatGeometry<T>& geometry = st.entry_splat[e];
             const SplatFootprint<T>& footprint = st.entry_footprint[e];
             raster::SplatSample<P> smp;
@@ -104,9 +106,8 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
             const Vec3<T> normal = footprint.normal;
             const raster::BlendSampleGrad<P> bg =
                 raster::unblend_sample(s, a, smp.z, color, channels, normal, I(typename I::I(e)));
-            const raster::SplatGradTerms<P> t =
-                raster::splat_grad_terms(geometry, cx, cy, smp.u, smp.v, smp.gauss,
-                                         smp.screen_branch | (a <= P(0)), smp.clamped, bg.g_alpha, bg.g_z);
+            const raster::SplatGradTerms<P> t = raster::splat_grad_terms(
+                geometry, cx, cy, smp, smp.screen_branch | (a <= P(0)), bg.g_alpha, bg.g_z);
             P q[kPadded];  // every entry assigned below (a `= {}` here costs a memset per iteration)
             for (int j = 0; j < 3; ++j) {
                 q[SlotLayout::kPa + j] = t.dx * t.g_p[j];

@@ -12,6 +12,7 @@
 #include <span>
 #include <vector>
 
+#include "lumigauss/math/hd.h"
 #include "lumigauss/render/raster_types.h"
 
 namespace lumigauss::cpu {
@@ -52,6 +53,17 @@ struct TileScratch {
     BlockLists lists;      // forward: every entry overlapping each block
     std::vector<T> grads;  // backward: per entry of the tile, its gradient sums
 };
+
+// A block's loop does too much work per entry for the processor to run ahead to the next entry's loads on
+// its own (the next iteration does not fit in its reorder window), so each iteration first asks for the
+// data of the entry kPrefetchAhead places further down its list.
+inline constexpr std::size_t kPrefetchAhead = 2;
+template <typename T>
+LG_HD_INLINE void prefetch_entry(const RasterState<T>& st, std::uint32_t e, int channels) {
+    __builtin_prefetch(&st.entry_splat[e]);
+    __builtin_prefetch(&st.entry_footprint[e]);
+    __builtin_prefetch(&st.entry_color[std::size_t(e) * channels]);
+}
 
 template <typename T>
 void build_block_lists(const RasterState<T>& st, int tile, const raster::PixelRect& tr, BlockLists& lists) {

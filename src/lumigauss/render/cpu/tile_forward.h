@@ -73,8 +73,12 @@ LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, RasterState<T>
         s.live = lane_select(lanes_in(tr, px, py), P(1), P(0));
         s.trans = P(1);
         s.median_entry = I(-1);
-        for (const std::uint32_t k : scratch.lists.block(b)) {
+        const std::span<const std::uint32_t> list = scratch.lists.block(b);
+        for (std::size_t n = 0; n < list.size(); ++n) {
+            const std::uint32_t k = list[n];
             const std::uint32_t e = begin + k;
+            if (n + kPrefetchAhead < list.size())
+                prefetch_entry(st, begin + list[n + kPrefetchAhead], channels);
             const SplatFootprint<T>& footprint = st.entry_footprint[e];
             raster::SplatSample<P> smp;
             const auto hit =
