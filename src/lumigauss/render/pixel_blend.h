@@ -73,10 +73,16 @@ LG_HD_INLINE LaneMask<L> blend_sample(BlendPixel<L, C>& s, L alpha, L z, const T
 }
 
 // The state of the backward walk, and the pixel's incoming gradients (zero where a map has none).
+//
+// dL/dalpha_i needs, for every map, this sample's value against the blend of the samples behind it:
+// sum over maps of (value_i - behind_i) . dL/dmap. The incoming gradients are fixed for the whole walk, so
+// instead of one "behind" blend per map (colours, normal, depth, alpha, distortion) the walk keeps their
+// dot product with the gradients, which blends the same way: behind . g <- a (value . g) + (1 - a) behind .
+// g.
 template <typename L, int C>
 struct BlendPixelBackward {
-    L trans{};  // transmittance behind the sample being processed: T_final at first
-    L acc_color[C]{}, acc_normal[3]{}, acc_z{}, acc_alpha{}, acc_dist{};  // blends of the samples behind
+    L trans{};       // transmittance behind the sample being processed: T_final at first
+    L behind_dot{};  // sum over maps of (blend of the samples behind) . dL/dmap
     L g_color[C]{}, g_normal[3]{}, g_depth{}, g_alpha{}, g_dist{}, g_median{};
     L bg_term{};  // T_final * (background . dL/dcolor)
     L a_total{};  // 1 - T_final
@@ -91,44 +97,54 @@ struct BlendSampleGrad {
     L w;             // its blending weight: dL/dcolor_c = w g_color_c, dL/dnormal_k = w g_normal_k
 };
 
-// Un-blends one sample, back to front: `a` is its alpha where the forward composited it, else 0 (which
-// leaves the state unchanged).
+// What un-blending a sample needs that does not depend on the walk (only on the sample and the pixel's
+// fixed gradients): its value in every map dotted with the map's gradient, and its mapped depth. Split
+// from unblend_sample so that a backend can compute it ahead of the walk.
+template <typename L>
+struct SampleValues {
+    L z;          // the sample's depth (1 where it was not composited: any finite value does)
+    L value_dot;  // sum over maps of (the sample's value) . dL/dmap
+    L m, dm_dz;   // distortion depth and its derivative
+};
+
 template <typename L, int C, typename T>
-LG_HD_INLINE BlendSampleGrad<L> unblend_sample(BlendPixelBackward<L, C>& s, L a, L z_sample, const T* color,
-                                               int channels, Vec3<T> normal, LaneIndex<L> entry) {
+LG_HD_INLINE SampleValues<L> sample_values(const BlendPixelBackward<L, C>& s, LaneMask<L> composited,
+                                           L z_sample, const T* color, int channels, Vec3<T> normal) {
+    SampleValues<L> v;
+    // The terms known from the entry alone come first, so that the chain of additions after z (the end
+    // of the kernel's longest path) is short.
+    v.value_dot = s.g_alpha;
+    for (int c = 0; c < C; ++c) v.value_dot += L(c < channels ? color[c] : T(0)) * s.g_color[c];
+    for (int k = 0; k < 3; ++k) v.value_dot += L(normal[k]) * s.g_normal[k];
+    v.z = lane_select(composited, z_sample, L(1));
+    const DistortionDepth<L> mapped = distortion_depth_and_derivative(v.z);
+    v.m = mapped.m;
+    v.dm_dz = mapped.dm_dz;
+    const L dist_w =
+        (v.m * v.m * s.a_total + s.m2 - L(2) * v.m * s.m1) * s.g_dist;  // dL/dw of the distortion
+    v.value_dot += v.z * s.g_depth + dist_w;
+    return v;
+}
+
+// Un-blends one sample, back to front: `a` is its alpha where the forward composited it, else 0 (which
+// leaves the state unchanged); `v` its sample_values.
+template <typename L, int C>
+LG_HD_INLINE BlendSampleGrad<L> unblend_sample(BlendPixelBackward<L, C>& s, L a, const SampleValues<L>& v,
+                                               LaneIndex<L> entry) {
     const L one_minus_a = L(1) - a;
     const L t_before = s.trans / one_minus_a;
     const L w = a * t_before;
     const auto composited = a > L(0);
-
-    // dL/dalpha: this sample's value against the blend of those behind it, for every map.
-    L g_alpha_inner{};
-    for (int c = 0; c < C; ++c) {
-        const L col = L(c < channels ? color[c] : T(0));
-        g_alpha_inner += (col - s.acc_color[c]) * s.g_color[c];
-    }
-    for (int k = 0; k < 3; ++k) g_alpha_inner += (L(normal[k]) - s.acc_normal[k]) * s.g_normal[k];
-    const L z = lane_select(composited, z_sample, L(1));
-    const DistortionDepth<L> mapped = distortion_depth_and_derivative(z);
-    const L m = mapped.m;
-    const L dist_w = (m * m * s.a_total + s.m2 - L(2) * m * s.m1) * s.g_dist;  // dL/dw of the distortion
-    g_alpha_inner += (z - s.acc_z) * s.g_depth + (L(1) - s.acc_alpha) * s.g_alpha + dist_w - s.acc_dist;
     BlendSampleGrad<L> out;
     out.w = w;
-    out.g_alpha = lane_select(composited, t_before * g_alpha_inner - s.bg_term / one_minus_a, L(0));
+    out.g_alpha =
+        lane_select(composited, t_before * (v.value_dot - s.behind_dot) - s.bg_term / one_minus_a, L(0));
     const L g_median = lane_select(s.median_entry == entry, s.g_median, L(0));
-    const L g_z = w * s.g_depth + g_median + L(2) * w * (m * s.a_total - s.m1) * s.g_dist * mapped.dm_dz;
+    const L g_z = w * s.g_depth + g_median + L(2) * w * (v.m * s.a_total - s.m1) * s.g_dist * v.dm_dz;
     out.g_z = lane_select(composited, g_z, L(0));
 
-    // Fold this sample into the "behind" blends of the sample in front of it.
-    for (int c = 0; c < C; ++c) {
-        const L col = L(c < channels ? color[c] : T(0));
-        s.acc_color[c] = a * col + one_minus_a * s.acc_color[c];
-    }
-    for (int k = 0; k < 3; ++k) s.acc_normal[k] = a * L(normal[k]) + one_minus_a * s.acc_normal[k];
-    s.acc_z = a * z + one_minus_a * s.acc_z;
-    s.acc_alpha = a + one_minus_a * s.acc_alpha;
-    s.acc_dist = a * dist_w + one_minus_a * s.acc_dist;
+    // Fold this sample into the blend behind the sample in front of it.
+    s.behind_dot = a * v.value_dot + one_minus_a * s.behind_dot;
     s.trans = t_before;
     return out;
 }

@@ -90,22 +90,39 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
         load_block(s, x0, y0, tr, channels, st, g);
         const I px = block_lane_x<T>() + I(x0), py = block_lane_y<T>() + I(y0);
         const P cx = pixel_centres(px), cy = pixel_centres(py);
+        // Evaluating an entry's kernel does not depend on the walk, so it runs one entry ahead: the
+        // iteration that un-blends entry n also evaluates entry n - 1, and the processor overlaps that
+        // long independent chain with the walk's own (one iteration alone is about the size of its
+        // reorder window, so it would not look that far ahead by itself).
+        struct Evaluated {
+            raster::SplatSample<P> smp;
+            P a;  // alpha where the forward composited the pair, else 0
+        };
+        const auto evaluate = [&](std::uint32_t n) __attribute__((always_inline)) {
+            const std::uint32_t k = kept[n];
+            const std::uint32_t e = begin + k;
+            Evaluated r;
+            const auto composited = raster::evaluate_splat(st.entry_splat[e], cx, cy, r.smp) &
+                                    lanes_in(st.entry_footprint[e].rect, px, py) &
+                                    (I(typename I::I(k + 1)) <= s.contributors);
+            r.a = lane_select(composited, r.smp.alpha, P(0));
+            return r;
+        };
+        Evaluated next = evaluate(kept_start[b + 1] - 1);
         for (std::uint32_t n = kept_start[b + 1]; n-- > kept_start[b];) {
             const std::uint32_t k = kept[n];
             const std::uint32_t e = begin + k;
             if (n >= kept_start[b] + kPrefetchAhead)
                 prefetch_entry(st, begin + kept[n - kPrefetchAhead], channels);
+            const Evaluated current = next;
+            if (n > kept_start[b]) next = evaluate(n - 1);
             const raster::SplatGeometry<T>& geometry = st.entry_splat[e];
+            const raster::SplatSample<P>& smp = current.smp;
+            const P a = current.a;
             const SplatFootprint<T>& footprint = st.entry_footprint[e];
-            raster::SplatSample<P> smp;
-            const auto composited = raster::evaluate_splat(geometry, cx, cy, smp) &
-                                    lanes_in(footprint.rect, px, py) &
-                                    (I(typename I::I(k + 1)) <= s.contributors);
-            const P a = lane_select(composited, smp.alpha, P(0));
-            const T* color = &st.entry_color[std::size_t(e) * channels];
-            const Vec3<T> normal = footprint.normal;
-            const raster::BlendSampleGrad<P> bg =
-                raster::unblend_sample(s, a, smp.z, color, channels, normal, I(typename I::I(e)));
+            const raster::SampleValues<P> values = raster::sample_values(
+                s, a > P(0), smp.z, &st.entry_color[std::size_t(e) * channels], channels, footprint.normal);
+            const raster::BlendSampleGrad<P> bg = raster::unblend_sample(s, a, values, I(typename I::I(e)));
             const raster::SplatGradTerms<P> t = raster::splat_grad_terms(
                 geometry, cx, cy, smp, smp.screen_branch | (a <= P(0)), bg.g_alpha, bg.g_z);
             P q[kPadded];  // every entry assigned below (a `= {}` here costs a memset per iteration)
