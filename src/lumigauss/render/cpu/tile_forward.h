@@ -74,18 +74,35 @@ LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, RasterState<T>
         s.trans = P(1);
         s.median_entry = I(-1);
         const std::span<const std::uint32_t> list = scratch.lists.block(b);
+        if (list.empty()) {
+            store_block(s, x0, y0, tr, channels, st, img);
+            continue;
+        }
+        // As in the backward (tile_backward.h), the kernel of the next entry is evaluated while the
+        // current one is blended: the two chains are independent and overlap.
+        struct Evaluated {
+            raster::SplatSample<P> smp;
+            P alpha;  // 0 where the pair does not contribute
+        };
+        const auto evaluate = [&](std::uint32_t k) __attribute__((always_inline)) {
+            const std::uint32_t e = begin + k;
+            Evaluated r;
+            const auto hit = raster::evaluate_splat(st.entry_splat[e], cx, cy, r.smp) &
+                             lanes_in(st.entry_footprint[e].rect, px, py);
+            r.alpha = lane_select(hit, r.smp.alpha, P(0));
+            return r;
+        };
+        Evaluated next = evaluate(list[0]);
         for (std::size_t n = 0; n < list.size(); ++n) {
             const std::uint32_t k = list[n];
             const std::uint32_t e = begin + k;
             if (n + kPrefetchAhead < list.size())
                 prefetch_entry(st, begin + list[n + kPrefetchAhead], channels);
-            const SplatFootprint<T>& footprint = st.entry_footprint[e];
-            raster::SplatSample<P> smp;
-            const auto hit =
-                raster::evaluate_splat(st.entry_splat[e], cx, cy, smp) & lanes_in(footprint.rect, px, py);
+            const Evaluated current = next;
+            if (n + 1 < list.size()) next = evaluate(list[n + 1]);
             const auto composited = raster::blend_sample(
-                s, lane_select(hit, smp.alpha, P(0)), smp.z, &st.entry_color[std::size_t(e) * channels],
-                channels, footprint.normal, I(typename I::I(e)), I(typename I::I(k + 1)));
+                s, current.alpha, current.smp.z, &st.entry_color[std::size_t(e) * channels], channels,
+                st.entry_footprint[e].normal, I(typename I::I(e)), I(typename I::I(k + 1)));
             const unsigned flags = any_of_each(composited, s.live > P(0));
             kept[num_kept] = k;
             num_kept += flags & 1;
