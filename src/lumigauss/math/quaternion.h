@@ -1,5 +1,6 @@
 #pragma once
 // Unit quaternions (w, x, y, z), w first, Hamilton convention as COLMAP and the 2DGS code.
+#include "lumigauss/math/lanes.h"
 #include "lumigauss/math/vec.h"
 
 namespace lumigauss {
@@ -15,7 +16,7 @@ LG_HD constexpr Mat3<T> rotation_from_unit_quaternion(Vec4<T> q) {
 
 template <typename T>
 LG_HD inline Vec4<T> normalize_quaternion(Vec4<T> q) {
-    const T inv = T(1) / std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+    const T inv = T(1) / lane_sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
     return {q.x * inv, q.y * inv, q.z * inv, q.w * inv};
 }
 

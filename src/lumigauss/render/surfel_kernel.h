@@ -4,44 +4,20 @@
 #include <cmath>
 #include <limits>
 
+#include "lumigauss/math/lanes.h"
 #include "lumigauss/render/raster_constants.h"
 #include "lumigauss/render/surfel_projection.h"
 
 namespace lumigauss::raster {
 
-// The kernel's formulas are written once for a "lane" type L: a scalar (float or double: the reference, the
-// blending-weight recorder, a CUDA thread) or a pack of pixels (the CPU backend's cpu::Pack8). For a pack,
-// comparisons give a per-lane mask and lane_select picks per lane; for a scalar, a bool and ?:.
-template <typename T>
-LG_HD_INLINE T lane_select(bool m, T a, T b) {
-    return m ? a : b;
-}
-template <typename L>
-using LaneMask = decltype(L{} < L{});
-
-// The scalar type of a lane type (L itself for scalars).
-template <typename L>
-struct LaneScalar {
-    using type = L;
-};
-template <typename L>
-requires requires {
-    typename L::Scalar;
-}
-struct LaneScalar<L> {
-    using type = typename L::Scalar;
-};
-template <typename L>
-using lane_scalar_t = typename LaneScalar<L>::type;
+// The kernel's formulas are written once for a lane type L (math/lanes.h): a scalar, or on the CPU a pack
+// of eight pixels.
 
 LG_HD_INLINE float exp2_integer(float k) {
     const int bits = (int(k) + 127) << 23;
     float scale;
     __builtin_memcpy(&scale, &bits, sizeof(float));
     return scale;
-}
-LG_HD_INLINE double lane_exp(double x) {
-    return std::exp(x);
 }
 
 template <typename L>
@@ -84,7 +60,7 @@ LG_HD_INLINE L kernel_exp(L x) {
 // and float keeps its precision):
 //   k x l = dx (tv x tw) + dy (tw x tu) + (c.x tw - tu) x (c.y tw - tv) = dx pa + dy pb + pd,  d = pix - c.
 template <typename T>
-struct alignas(16 * sizeof(T)) SplatGeometry {  // 16 values: one 64-byte cache line in float
+struct alignas(16 * sizeof(lane_scalar_t<T>)) SplatGeometry {  // 16 values: a 64-byte cache line in float
     Vec3<T> pa, pb, pd;
     Vec3<T> tw;
     Vec2<T> center;

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 
+#include "lumigauss/math/lanes.h"
 #include "lumigauss/math/quaternion.h"
 #include "lumigauss/math/vec.h"
 #include "lumigauss/render/raster_constants.h"
@@ -68,26 +69,34 @@ LG_HD inline PixelRect pixel_rect(Vec2<T> lo, Vec2<T> hi, int width, int height)
 // The image of the disk u² + v² <= c2 has the dual conic C* = T diag(c2, c2, -1) Tᵀ; its bounding box
 // follows from the tangent lines x = const and y = const. It is an ellipse, and the box valid, only when
 // d = c2 (tw.x² + tw.y²) - tw.z² < 0: the whole disk lies in front of the camera plane.
-template <typename T>
-LG_HD inline T conic_denominator(Vec3<T> tw, T c2) {
+// (These and the functions below are written for a lane type L, math/lanes.h: a scalar, or several
+// surfels at once.)
+template <typename L>
+LG_HD_INLINE L conic_denominator(Vec3<L> tw, L c2) {
     return c2 * (tw.x * tw.x + tw.y * tw.y) - tw.z * tw.z;
 }
 
-template <typename T>
+template <typename L>
 struct ConicBox {
-    Vec2<T> center;
-    T half_x, half_y;
+    Vec2<L> center;
+    L half_x, half_y;
 };
 
-template <typename T>
-LG_HD inline ConicBox<T> conic_box(Vec3<T> tu, Vec3<T> tv, Vec3<T> tw, T c2, T d) {
-    const Vec3<T> f{c2 / d, c2 / d, T(-1) / d};
-    ConicBox<T> box;
+template <typename L>
+LG_HD_INLINE Vec2<L> conic_center(Vec3<L> tu, Vec3<L> tv, Vec3<L> tw, L c2, L d) {
+    const Vec3<L> f{c2 / d, c2 / d, L(-1) / d};
+    return {dot(f, hadamard(tu, tw)), dot(f, hadamard(tv, tw))};
+}
+
+template <typename L>
+LG_HD_INLINE ConicBox<L> conic_box(Vec3<L> tu, Vec3<L> tv, Vec3<L> tw, L c2, L d) {
+    const Vec3<L> f{c2 / d, c2 / d, L(-1) / d};
+    ConicBox<L> box;
     box.center = {dot(f, hadamard(tu, tw)), dot(f, hadamard(tv, tw))};
-    const T ex = box.center.x * box.center.x - dot(f, hadamard(tu, tu));
-    const T ey = box.center.y * box.center.y - dot(f, hadamard(tv, tv));
-    box.half_x = std::sqrt(ex > T(0) ? ex : T(0));
-    box.half_y = std::sqrt(ey > T(0) ? ey : T(0));
+    const L ex = box.center.x * box.center.x - dot(f, hadamard(tu, tu));
+    const L ey = box.center.y * box.center.y - dot(f, hadamard(tv, tv));
+    box.half_x = lane_sqrt(lane_max(ex, L(0)));
+    box.half_y = lane_sqrt(lane_max(ey, L(0)));
     return box;
 }
 
@@ -95,111 +104,135 @@ LG_HD inline ConicBox<T> conic_box(Vec3<T> tu, Vec3<T> tv, Vec3<T> tw, T c2, T d
 // kAlphaMin: opacity * exp(-rho / 2) >= kAlphaMin. Negative when it never does. A hair of slack, so that
 // work skipped on this bound is never work the exact alpha test would keep.
 template <typename T>
-LG_HD inline T reach_rho(T opacity) {
+LG_HD_INLINE T reach_rho(T opacity) {
     const T ratio = opacity / T(kAlphaMin);
     return ratio > T(1) ? T(2) * std::log(ratio) * T(1.0001) + T(1e-6) : T(-1);
+}
+
+// A world-to-camera rotation (of the view's scalar type V) applied to a vector of lanes.
+template <typename L, typename V>
+LG_HD_INLINE Vec3<L> rotate(const Mat3<V>& R, Vec3<L> v) {
+    const auto row = [&](int r) { return L(R(r, 0)) * v.x + L(R(r, 1)) * v.y + L(R(r, 2)) * v.z; };
+    return {row(0), row(1), row(2)};
 }
 
 // True when a sphere (centre in camera space, squared radius) lies wholly in front of the near plane and
 // wholly beyond one side of the view frustum widened by `margin` pixels. A cheap test that spares most
 // off-screen surfels the exact projection below; it never rejects anything that exact bound would keep.
-template <typename T>
-LG_HD inline bool sphere_outside_view(Vec3<T> c, T radius_sq, T margin, const PinholeView<T>& view) {
-    const T front = c.z - T(kNearPlane);
-    if (!(front > T(0) && front * front > radius_sq)) return false;  // may reach the camera plane
+template <typename L, typename V>
+LG_HD_INLINE LaneMask<L> sphere_outside_view(Vec3<L> c, L radius_sq, L margin, const PinholeView<V>& view) {
+    const L front = c.z - L(kNearPlane);
+    const auto in_front = (front > L(0)) & (front * front > radius_sq);  // cannot reach the camera plane
     // Each side is a plane through the camera centre, a.c >= 0 on the visible side (u >= -margin,
     // u <= W + margin, and likewise for v). Beyond it by more than the radius: a.c < -r |a|.
-    const auto beyond = [&](T a_xy, T a_z, T xy) {
-        const T d = a_xy * xy + a_z * c.z;
-        return d < T(0) && d * d > radius_sq * (a_xy * a_xy + a_z * a_z);
+    const auto beyond = [&](L a_xy, L a_z, L xy) {
+        const L d = a_xy * xy + a_z * c.z;
+        return (d < L(0)) & (d * d > radius_sq * (a_xy * a_xy + a_z * a_z));
     };
-    return beyond(view.fx, view.cx + margin, c.x) ||
-           beyond(-view.fx, T(view.width) + margin - view.cx, c.x) ||
-           beyond(view.fy, view.cy + margin, c.y) || beyond(-view.fy, T(view.height) + margin - view.cy, c.y);
+    const L fx(view.fx), fy(view.fy);
+    return in_front & (beyond(fx, L(view.cx) + margin, c.x) |
+                       beyond(-fx, L(V(view.width) - view.cx) + margin, c.x) |
+                       beyond(fy, L(view.cy) + margin, c.y) |
+                       beyond(-fy, L(V(view.height) - view.cy) + margin, c.y));
 }
 
-// Projects one surfel. Returns false when it cannot be seen (behind the near plane, exactly edge-on,
-// too transparent to ever reach kAlphaMin, degenerate, or off-screen).
+// Everything the projection decides about a surfel, before its reachable region is rounded to pixels.
+template <typename L>
+struct ProjectionLanes {
+    Vec3<L> tu, tv, tw;
+    Vec2<L> center;
+    Vec3<L> normal;
+    L flip, depth, reach;
+    LaneMask<L> conic_center;
+    LaneMask<L> whole_image;  // the reachable disk crosses the camera plane: every pixel may be reached
+    Vec2<L> lo, hi;           // otherwise the reachable region's bounds in pixels (pixel_rect rounds them)
+};
+
+// Projects a surfel (or several, one per lane) of reach `reach` = reach_rho(opacity), which the caller
+// computes (a logarithm per surfel, which no pack instruction does). Returns where it can be seen: false where it is behind
+// the near plane, exactly edge-on, too transparent to ever reach kAlphaMin, degenerate, or off-screen.
+// Written without early returns (every test folds into the mask), so that it runs on packs of surfels;
+// values in lanes that fail are unspecified.
 //
 // Two things are bounded separately. The screen low-pass filter is centred on the 3-sigma dual-conic box
 // centre, as in the reference implementation. The pixels it may touch are bounded exactly: where
 // opacity * exp(-rho/2) >= kAlphaMin, i.e. inside the ellipse rho_object <= reach_rho(opacity) or the
 // filter disk rho_screen <= reach_rho(opacity). Nothing that reaches alpha 1/255 is cut off, so the image
 // does not depend on the tile size, and no pixel is visited that cannot contribute.
-template <typename T>
-LG_HD inline bool project_surfel(const SurfelGeometry<T>& g, T opacity, const PinholeView<T>& view,
-                                 ProjectedSurfel<T>& out) {
-    const T reach = reach_rho(opacity);
-    if (!(reach > T(0))) return false;
+template <typename L, typename V>
+LG_HD_INLINE LaneMask<L> project_surfel_lanes(const SurfelGeometry<L>& g, L reach, const PinholeView<V>& view,
+                                              ProjectionLanes<L>& out) {
     out.reach = reach;
-    const Vec3<T> mean_cam = view.rotation * g.mean + view.translation;
-    if (!(mean_cam.z > T(kNearPlane))) return false;
+    auto visible = reach > L(0);
+    const Vec3<L> mean_cam = rotate(view.rotation, g.mean) +
+                             Vec3<L>{L(view.translation.x), L(view.translation.y), L(view.translation.z)};
+    visible = visible & (mean_cam.z > L(kNearPlane));
     // Everything the surfel can reach: its disk out to rho = reach (or 3 sigma, which bounds the filter
     // centre), then the screen filter's radius around that in pixels (plus one for rounding).
-    const T sigma = g.scale_u > g.scale_v ? g.scale_u : g.scale_v;
-    const T disk_sq =
-        (reach > T(kSigmaCutoff * kSigmaCutoff) ? reach : T(kSigmaCutoff * kSigmaCutoff)) * sigma * sigma;
-    if (sphere_outside_view(mean_cam, disk_sq, std::sqrt(reach / T(kFilterInvSquare)) + T(1), view))
-        return false;
-    const Mat3<T> R = rotation_from_unit_quaternion(normalize_quaternion(g.quat));
-    const Vec3<T> a = view.rotation * (g.scale_u * R.col(0));
-    const Vec3<T> b = view.rotation * (g.scale_v * R.col(1));
-    const Vec3<T> n_cam = view.rotation * R.col(2);
+    const L sigma = lane_max(g.scale_u, g.scale_v);
+    const L c2 = L(kSigmaCutoff * kSigmaCutoff);
+    const L disk_sq = lane_max(reach, c2) * sigma * sigma;
+    const L filter = lane_sqrt(lane_max(reach, L(0)) / L(kFilterInvSquare));  // rho_screen <= reach within
+    visible = visible & lane_not(sphere_outside_view(mean_cam, disk_sq, filter + L(1), view));
+    const Mat3<L> R = rotation_from_unit_quaternion(normalize_quaternion(g.quat));
+    const Vec3<L> a = rotate(view.rotation, g.scale_u * R.col(0));
+    const Vec3<L> b = rotate(view.rotation, g.scale_v * R.col(1));
+    const Vec3<L> n_cam = rotate(view.rotation, R.col(2));
     // The surfel faces the camera when its normal points back along the viewing ray.
-    const T facing = -dot(mean_cam, n_cam);
-    if (facing == T(0)) return false;
-    out.flip = facing > 0 ? T(1) : T(-1);
+    const L facing = -dot(mean_cam, n_cam);
+    visible = visible & (facing != L(0));
+    out.flip = lane_select(facing > L(0), L(1), L(-1));
     out.normal = out.flip * R.col(2);
     // Rows of K [a b mean_cam].
-    out.tu = {view.fx * a.x + view.cx * a.z, view.fx * b.x + view.cx * b.z,
-              view.fx * mean_cam.x + view.cx * mean_cam.z};
-    out.tv = {view.fy * a.y + view.cy * a.z, view.fy * b.y + view.cy * b.z,
-              view.fy * mean_cam.y + view.cy * mean_cam.z};
+    const L fx(view.fx), fy(view.fy), cx(view.cx), cy(view.cy);
+    out.tu = {fx * a.x + cx * a.z, fx * b.x + cx * b.z, fx * mean_cam.x + cx * mean_cam.z};
+    out.tv = {fy * a.y + cy * a.z, fy * b.y + cy * b.z, fy * mean_cam.y + cy * mean_cam.z};
     out.tw = {a.z, b.z, mean_cam.z};
     out.depth = mean_cam.z;
 
-    // Filter centre.
-    const T c2 = T(kSigmaCutoff * kSigmaCutoff);
-    const T d3 = conic_denominator(out.tw, c2);
-    out.conic_center = d3 < 0;
-    // When the 3-sigma disk crosses the camera plane its box is meaningless; the projected mean (in front of
-    // the camera) centres the filter instead.
-    out.center = out.conic_center ? conic_box(out.tu, out.tv, out.tw, c2, d3).center
-                                  : Vec2<T>{out.tu.z / out.tw.z, out.tv.z / out.tw.z};
-    // Near the boundary of that case (d3 -> 0-) the conic centre runs off to infinity. It is also the origin
-    // of the per-pixel expansion (make_splat_geometry), where a far origin cancels catastrophically (a
-    // plaza training run met a 1.2 m-deep surfel whose centre overflowed and made NaN gradients). Far
-    // outside the image the filter cannot reach any pixel anyway, so the crossing-case centre is used.
-    if (out.conic_center) {
-        const T margin = T(2) * T(view.width + view.height);
-        const T cx = out.center.x, cy = out.center.y;
-        const T max_x = T(view.width) + margin, max_y = T(view.height) + margin;
-        const bool near_image = cx > -margin && max_x > cx && cy > -margin && max_y > cy;
-        if (!near_image) {
-            out.conic_center = false;
-            out.center = {out.tu.z / out.tw.z, out.tv.z / out.tw.z};
-        }
-    }
-    if (!(std::isfinite(out.center.x) && std::isfinite(out.center.y))) return false;
+    // Filter centre: the 3-sigma box's centre. When that disk crosses the camera plane (d3 >= 0) its box
+    // is meaningless, and the projected mean (in front of the camera) centres the filter instead. Near the
+    // boundary of that case (d3 -> 0-) the conic centre runs off to infinity; it is also the origin of the
+    // per-pixel expansion (make_splat_geometry), where a far origin cancels catastrophically (a plaza
+    // training run met a 1.2 m-deep surfel whose centre overflowed and made NaN gradients). Far outside
+    // the image the filter cannot reach any pixel anyway, so the crossing-case centre is used there too.
+    const L d3 = conic_denominator(out.tw, c2);
+    const Vec2<L> conic = conic_center(out.tu, out.tv, out.tw, c2, d3);
+    const L margin = L(V(2) * V(view.width + view.height));
+    const auto near_image = (conic.x > -margin) & (L(V(view.width)) + margin > conic.x) &
+                            (conic.y > -margin) & (L(V(view.height)) + margin > conic.y);
+    out.conic_center = (d3 < L(0)) & near_image;
+    out.center = {lane_select(out.conic_center, conic.x, out.tu.z / out.tw.z),
+                  lane_select(out.conic_center, conic.y, out.tv.z / out.tw.z)};
+    visible = visible & lane_isfinite(out.center.x) & lane_isfinite(out.center.y);
 
-    // Pixels it can reach.
-    const T d_reach = conic_denominator(out.tw, reach);
-    if (d_reach < 0) {
-        const ConicBox<T> box = conic_box(out.tu, out.tv, out.tw, reach, d_reach);
-        const T filter = std::sqrt(reach / T(kFilterInvSquare));  // rho_screen <= reach within this distance
-        const auto lo = [](T a_, T b_) { return a_ < b_ ? a_ : b_; };
-        const auto hi = [](T a_, T b_) { return a_ > b_ ? a_ : b_; };
-        out.rect = pixel_rect<T>({lo(box.center.x - box.half_x, out.center.x - filter),
-                                  lo(box.center.y - box.half_y, out.center.y - filter)},
-                                 {hi(box.center.x + box.half_x, out.center.x + filter),
-                                  hi(box.center.y + box.half_y, out.center.y + filter)},
-                                 view.width, view.height);
-    } else {
-        // The reachable part of the disk crosses the camera plane: its image is unbounded, so the whole image
-        // is visited and the per-pixel near test removes what lies behind.
-        out.rect = {0, 0, view.width - 1, view.height - 1};
-    }
-    return !out.rect.empty();
+    // Pixels it can reach. When the reachable part of the disk crosses the camera plane its image is
+    // unbounded: the whole image is visited and the per-pixel near test removes what lies behind.
+    const L d_reach = conic_denominator(out.tw, reach);
+    out.whole_image = lane_not(d_reach < L(0));
+    const ConicBox<L> box = conic_box(out.tu, out.tv, out.tw, reach, d_reach);
+    out.lo = {lane_min(box.center.x - box.half_x, out.center.x - filter),
+              lane_min(box.center.y - box.half_y, out.center.y - filter)};
+    out.hi = {lane_max(box.center.x + box.half_x, out.center.x + filter),
+              lane_max(box.center.y + box.half_y, out.center.y + filter)};
+    return visible;
+}
+
+// The pixels of a projection (one lane's values): the whole image, or its reachable region rounded.
+template <typename T>
+LG_HD inline PixelRect reachable_pixels(bool whole_image, Vec2<T> lo, Vec2<T> hi, int width, int height) {
+    return whole_image ? PixelRect{0, 0, width - 1, height - 1} : pixel_rect(lo, hi, width, height);
+}
+
+// Projects one surfel. Returns false when it cannot be seen (see project_surfel_lanes) or reaches no pixel.
+template <typename T>
+LG_HD inline bool project_surfel(const SurfelGeometry<T>& g, T opacity, const PinholeView<T>& view,
+                                 ProjectedSurfel<T>& out) {
+    ProjectionLanes<T> p;
+    const bool visible = project_surfel_lanes(g, reach_rho(opacity), view, p);
+    out = {p.tu, p.tv, p.tw, p.center, p.normal, p.flip, p.depth, p.reach, p.conic_center,
+           reachable_pixels(p.whole_image, p.lo, p.hi, view.width, view.height)};
+    return visible && !out.rect.empty();
 }
 
 // Gradients reaching one projected surfel from the pixels.

@@ -1,11 +1,13 @@
 #pragma once
-// Eight pixels as one value: the lane type of the CPU backend's tile kernels.
+// Several values as one: the lane types of the CPU backend.
 //
-// Pack8<T> wraps a GCC/Clang vector of eight floats (or doubles, for the double-precision reference path)
-// with ordinary arithmetic, so the per-pixel formulas of surfel_kernel.h and pixel_blend.h, written once
-// for a scalar T, also run on eight pixels at a time: comparisons give a Mask8, lane_select picks per
-// lane. Nothing here is x86-specific; each per-instruction-set clone of the tile kernels (multiversion.h)
-// compiles these operations to its own vector width (two SSE halves, one AVX2 or AVX-512VL register).
+// Pack<T, N> wraps a GCC/Clang vector of N floats or doubles with ordinary arithmetic, so that the
+// per-pixel and per-surfel formulas written once for a lane type (math/lanes.h) also run on N values at a
+// time: comparisons give a mask (LaneInt of all-ones or zero lanes), lane_select picks per lane. The tile
+// kernels use eight pixels (Pack8<float>; Pack8<double> for the double-precision reference path), the
+// projection four surfels in double (Pack4d: GCC 12 turns eight-double comparisons into scalar code in
+// per-instruction-set clones, four-double ones into vector instructions). Nothing here is x86-specific;
+// each per-instruction-set clone (multiversion.h) compiles these operations to its own vector width.
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -13,86 +15,105 @@
 
 namespace lumigauss::cpu {
 
-inline constexpr int kLanes = 8;
+inline constexpr int kLanes = 8;  // pixels per pack in the tile kernels
 
-// The vector types of eight lanes (GCC applies vector_size only to concrete types, hence one per scalar).
-template <typename T>
+// The vector types of N lanes of T, and the integers of T's width.
+template <typename T, int N>
 struct LaneVectors;
-template <>
-struct LaneVectors<float> {
+template <int N>
+struct LaneVectors<float, N> {
     using Int = std::int32_t;
-    typedef float F __attribute__((vector_size(kLanes * sizeof(float))));
-    typedef std::int32_t I __attribute__((vector_size(kLanes * sizeof(std::int32_t))));
+    typedef float F __attribute__((vector_size(N * sizeof(float))));
+    typedef std::int32_t I __attribute__((vector_size(N * sizeof(std::int32_t))));
 };
-template <>
-struct LaneVectors<double> {
+template <int N>
+struct LaneVectors<double, N> {
     using Int = std::int64_t;
-    typedef double F __attribute__((vector_size(kLanes * sizeof(double))));
-    typedef std::int64_t I __attribute__((vector_size(kLanes * sizeof(std::int64_t))));
+    typedef double F __attribute__((vector_size(N * sizeof(double))));
+    typedef std::int64_t I __attribute__((vector_size(N * sizeof(std::int64_t))));
 };
 
 // Per-lane integers of T's width: lane masks (all bits set = true) and per-pixel indices.
-template <typename T>
-struct Int8 {
-    using I = typename LaneVectors<T>::Int;
-    using V = typename LaneVectors<T>::I;
+template <typename T, int N>
+struct LaneInt {
+    using I = typename LaneVectors<T, N>::Int;
+    using V = typename LaneVectors<T, N>::I;
     V v;
-    Int8() = default;
-    constexpr Int8(V x) : v(x) {}
-    Int8(I s) : v(__builtin_shuffle(V{s}, V{})) {}  // broadcast (see Pack8)
+    LaneInt() = default;
+    constexpr LaneInt(V x) : v(x) {}
+    LaneInt(I s) : v(__builtin_shuffle(V{s}, V{})) {}  // broadcast (see Pack)
     I operator[](int i) const { return v[i]; }
-    friend Int8 operator&(Int8 a, Int8 b) { return {a.v & b.v}; }
-    friend Int8 operator|(Int8 a, Int8 b) { return {a.v | b.v}; }
-    friend Int8 operator==(Int8 a, Int8 b) { return {a.v == b.v}; }
-    friend Int8 operator<=(Int8 a, Int8 b) { return {a.v <= b.v}; }
-    friend Int8 operator>=(Int8 a, Int8 b) { return {a.v >= b.v}; }
-    friend Int8 operator+(Int8 a, Int8 b) { return {a.v + b.v}; }
+    friend LaneInt operator&(LaneInt a, LaneInt b) { return {a.v & b.v}; }
+    friend LaneInt operator|(LaneInt a, LaneInt b) { return {a.v | b.v}; }
+    friend LaneInt operator==(LaneInt a, LaneInt b) { return {a.v == b.v}; }
+    friend LaneInt operator<=(LaneInt a, LaneInt b) { return {a.v <= b.v}; }
+    friend LaneInt operator>=(LaneInt a, LaneInt b) { return {a.v >= b.v}; }
+    friend LaneInt operator+(LaneInt a, LaneInt b) { return {a.v + b.v}; }
 };
-template <typename T>
-using Mask8 = Int8<T>;
 
-template <typename T>
-struct Pack8 {
+template <typename T, int N>
+struct Pack {
     using Scalar = T;
-    using Index = Int8<T>;
-    using V = typename LaneVectors<T>::F;
+    using Index = LaneInt<T, N>;
+    using V = typename LaneVectors<T, N>::F;
+    static constexpr int kSize = N;
     V v;
-    Pack8() = default;
-    constexpr Pack8(V x) : v(x) {}
+    Pack() = default;
+    constexpr Pack(V x) : v(x) {}
     // Broadcast, spelled as lane 0 shuffled into every lane: GCC 12 compiles that to one broadcast, while
     // `s - V{}` or a lane-by-lane initialiser in a constructor become chains of inserts, and `V{} + s`
     // costs an add (0 + -0 is +0).
-    Pack8(T s)
-        : v(__builtin_shuffle(V{s}, typename Int8<T>::V{})) {}  // implicit: formulas mix packs, scalars
+    Pack(T s) : v(__builtin_shuffle(V{s}, typename Index::V{})) {}  // implicit: formulas mix packs, scalars
     template <typename U>
     requires std::is_arithmetic_v<U>
-    explicit Pack8(U s) : Pack8(static_cast<T>(s)) {}  // L(constant), as T(constant) for a scalar
+    explicit Pack(U s) : Pack(static_cast<T>(s)) {}  // L(constant), as T(constant) for a scalar
     T operator[](int i) const { return v[i]; }
 
-    friend Pack8 operator+(Pack8 a, Pack8 b) { return {a.v + b.v}; }
-    friend Pack8 operator-(Pack8 a, Pack8 b) { return {a.v - b.v}; }
-    friend Pack8 operator*(Pack8 a, Pack8 b) { return {a.v * b.v}; }
-    friend Pack8 operator/(Pack8 a, Pack8 b) { return {a.v / b.v}; }
-    friend Pack8 operator-(Pack8 a) { return {-a.v}; }
-    Pack8& operator+=(Pack8 b) { return v += b.v, *this; }
-    Pack8& operator-=(Pack8 b) { return v -= b.v, *this; }
-    Pack8& operator*=(Pack8 b) { return v *= b.v, *this; }
+    friend Pack operator+(Pack a, Pack b) { return {a.v + b.v}; }
+    friend Pack operator-(Pack a, Pack b) { return {a.v - b.v}; }
+    friend Pack operator*(Pack a, Pack b) { return {a.v * b.v}; }
+    friend Pack operator/(Pack a, Pack b) { return {a.v / b.v}; }
+    friend Pack operator-(Pack a) { return {-a.v}; }
+    Pack& operator+=(Pack b) { return v += b.v, *this; }
+    Pack& operator-=(Pack b) { return v -= b.v, *this; }
+    Pack& operator*=(Pack b) { return v *= b.v, *this; }
 
-    friend Mask8<T> operator<(Pack8 a, Pack8 b) { return {a.v < b.v}; }
-    friend Mask8<T> operator<=(Pack8 a, Pack8 b) { return {a.v <= b.v}; }
-    friend Mask8<T> operator>(Pack8 a, Pack8 b) { return {a.v > b.v}; }
-    friend Mask8<T> operator>=(Pack8 a, Pack8 b) { return {a.v >= b.v}; }
-    friend Mask8<T> operator==(Pack8 a, Pack8 b) { return {a.v == b.v}; }
-    friend Mask8<T> operator!=(Pack8 a, Pack8 b) { return {a.v != b.v}; }
+    friend Index operator<(Pack a, Pack b) { return {a.v < b.v}; }
+    friend Index operator<=(Pack a, Pack b) { return {a.v <= b.v}; }
+    friend Index operator>(Pack a, Pack b) { return {a.v > b.v}; }
+    friend Index operator>=(Pack a, Pack b) { return {a.v >= b.v}; }
+    friend Index operator==(Pack a, Pack b) { return {a.v == b.v}; }
+    friend Index operator!=(Pack a, Pack b) { return {a.v != b.v}; }
 };
 
+// The tile kernels' names: eight lanes.
 template <typename T>
-inline Pack8<T> lane_select(Mask8<T> m, Pack8<T> a, Pack8<T> b) {
+using Pack8 = Pack<T, kLanes>;
+template <typename T>
+using Int8 = LaneInt<T, kLanes>;
+template <typename T>
+using Mask8 = Int8<T>;
+using Pack4d = Pack<double, 4>;
+
+template <typename T, int N>
+inline Pack<T, N> lane_select(LaneInt<T, N> m, Pack<T, N> a, Pack<T, N> b) {
     return {m.v ? a.v : b.v};
 }
-template <typename T>
-inline Int8<T> lane_select(Mask8<T> m, Int8<T> a, Int8<T> b) {
+template <typename T, int N>
+inline LaneInt<T, N> lane_select(LaneInt<T, N> m, LaneInt<T, N> a, LaneInt<T, N> b) {
     return {m.v ? a.v : b.v};
+}
+template <typename T, int N>
+inline LaneInt<T, N> lane_not(LaneInt<T, N> m) {
+    return {~m.v};
+}
+// Square root per lane (math/lanes.h has the scalar ones). Without errno (-fno-math-errno), this compiles
+// to the vector instruction.
+template <typename T, int N>
+inline Pack<T, N> lane_sqrt(Pack<T, N> x) {
+    Pack<T, N> r;
+    for (int i = 0; i < N; ++i) r.v[i] = std::sqrt(x.v[i]);
+    return r;
 }
 
 // True if any lane of the mask is set.

@@ -25,32 +25,68 @@ Vec3<T> to(Vec3<double> v) {
     return v.cast<T>();
 }
 
+// Stores one projected surfel: the projection state the backward reads, what the per-pixel kernel reads,
+// and the footprint binning reads. Returns false (and stores nothing) when it reaches no pixel.
+template <typename T>
+LG_ALWAYS_INLINE bool store_projection(const ProjectedSurfel<double>& p, double opacity, RasterState<T>& st,
+                                       std::size_t i) {
+    if (p.rect.empty()) return false;
+    const auto sg = raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, opacity, p.reach);
+    st.projected[i] = {to<T>(p.tu),     to<T>(p.tv), to<T>(p.tw), {T(p.center.x), T(p.center.y)},
+                       to<T>(p.normal), T(p.flip),   T(p.depth),  T(p.reach),
+                       p.conic_center,  p.rect};
+    st.splats[i] = {
+        to<T>(sg.pa),  to<T>(sg.pb),    to<T>(sg.pd), to<T>(sg.tw), {T(sg.center.x), T(sg.center.y)},
+        T(sg.opacity), T(sg.rho_cutoff)};
+    st.footprints[i] = {p.rect, to<T>(p.normal), T(p.depth)};
+    return true;
+}
+
 // The per-surfel set-up runs in double whatever T is: it is cheap next to the per-pixel work, and the
 // kernel's coefficients (differences of nearly equal products) keep their precision when rounded to float.
+// Four surfels at a time, one per lane of a pack of doubles (project_surfel_lanes is the scalar
+// projection's own code); lanes past `end` repeat the last surfel and are not stored. (The splat geometry
+// is set up per surfel from the extracted lanes: done in lanes too, it measured 20 % slower.)
 template <typename T>
 LG_ALWAYS_INLINE void project_range(const SurfelBatch<T>& surfels, RasterState<T>& st,
                                     const raster::PinholeView<double>& view, std::size_t begin,
                                     std::size_t end) {
-    for (std::size_t i = begin; i != end; ++i) {
-        const double opacity = double(surfels.opacities[i]);
-        const auto g = surfels.geometry(i);
-        const raster::SurfelGeometry<double> gd{
-            g.mean.template cast<double>(),
-            {double(g.quat.x), double(g.quat.y), double(g.quat.z), double(g.quat.w)},
-            double(g.scale_u),
-            double(g.scale_v)};
-        ProjectedSurfel<double> p;
-        const bool ok = raster::project_surfel(gd, opacity, view, p);
-        st.visible[i] = ok ? 1 : 0;
-        if (!ok) continue;
-        const auto sg = raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, opacity, p.reach);
-        st.projected[i] = {to<T>(p.tu),     to<T>(p.tv), to<T>(p.tw), {T(p.center.x), T(p.center.y)},
-                           to<T>(p.normal), T(p.flip),   T(p.depth),  T(p.reach),
-                           p.conic_center,  p.rect};
-        st.splats[i] = {
-            to<T>(sg.pa),  to<T>(sg.pb),    to<T>(sg.pd), to<T>(sg.tw), {T(sg.center.x), T(sg.center.y)},
-            T(sg.opacity), T(sg.rho_cutoff)};
-        st.footprints[i] = {p.rect, to<T>(p.normal), T(p.depth)};
+    using P = cpu::Pack4d;
+    for (std::size_t first = begin; first < end; first += P::kSize) {
+        raster::SurfelGeometry<P> g;
+        P opacity, reach;
+        for (int l = 0; l < P::kSize; ++l) {
+            const std::size_t i = std::min(first + std::size_t(l), end - 1);
+            const auto gi = surfels.geometry(i);
+            for (int k = 0; k < 3; ++k) g.mean[k].v[l] = double(gi.mean[k]);
+            for (int k = 0; k < 4; ++k) g.quat[k].v[l] = double(gi.quat[k]);
+            g.scale_u.v[l] = double(gi.scale_u);
+            g.scale_v.v[l] = double(gi.scale_v);
+            opacity.v[l] = double(surfels.opacities[i]);
+            reach.v[l] = raster::reach_rho(opacity.v[l]);
+        }
+        raster::ProjectionLanes<P> p;
+        const auto visible = raster::project_surfel_lanes(g, reach, view, p);
+        for (int l = 0; l < P::kSize && first + std::size_t(l) < end; ++l) {
+            const std::size_t i = first + std::size_t(l);
+            bool stored = false;
+            if (visible[l]) {
+                const Vec2<double> lo{p.lo.x[l], p.lo.y[l]}, hi{p.hi.x[l], p.hi.y[l]};
+                const ProjectedSurfel<double> one{
+                    {p.tu.x[l], p.tu.y[l], p.tu.z[l]},
+                    {p.tv.x[l], p.tv.y[l], p.tv.z[l]},
+                    {p.tw.x[l], p.tw.y[l], p.tw.z[l]},
+                    {p.center.x[l], p.center.y[l]},
+                    {p.normal.x[l], p.normal.y[l], p.normal.z[l]},
+                    p.flip[l],
+                    p.depth[l],
+                    p.reach[l],
+                    p.conic_center[l] != 0,
+                    raster::reachable_pixels(p.whole_image[l] != 0, lo, hi, view.width, view.height)};
+                stored = store_projection(one, opacity[l], st, i);
+            }
+            st.visible[i] = stored ? 1 : 0;
+        }
     }
 }
 

@@ -1,0 +1,64 @@
+#pragma once
+// Scalar "lanes": the per-surfel and per-pixel formulas of the renderer are written once for a lane type L,
+// either a scalar (float or double: references, tests, one CUDA thread) or a pack of values computed at once
+// (the CPU backend's cpu::Pack8, which brings its own overloads of these functions, found by argument-
+// dependent lookup). For a pack, comparisons give a per-lane mask and lane_select picks per lane; for a
+// scalar, a bool and ?:.
+#include <cmath>
+
+#include "lumigauss/math/hd.h"
+
+namespace lumigauss {
+
+template <typename T>
+LG_HD_INLINE T lane_select(bool m, T a, T b) {
+    return m ? a : b;
+}
+LG_HD_INLINE bool lane_not(bool m) {
+    return !m;
+}
+template <typename L>
+using LaneMask = decltype(L{} < L{});
+
+// The scalar type of a lane type (L itself for scalars).
+template <typename L>
+struct LaneScalar {
+    using type = L;
+};
+template <typename L>
+requires requires {
+    typename L::Scalar;
+}
+struct LaneScalar<L> {
+    using type = typename L::Scalar;
+};
+template <typename L>
+using lane_scalar_t = typename LaneScalar<L>::type;
+
+LG_HD_INLINE float lane_sqrt(float x) {
+    return std::sqrt(x);
+}
+LG_HD_INLINE double lane_sqrt(double x) {
+    return std::sqrt(x);
+}
+LG_HD_INLINE double lane_exp(double x) {
+    return std::exp(x);
+}
+
+// True where x is finite (x - x is 0 for finite x, NaN for infinities and NaN). Needs IEEE semantics
+// (no -ffinite-math-only), which the project keeps.
+template <typename L>
+LG_HD_INLINE LaneMask<L> lane_isfinite(L x) {
+    return (x - x) == L(0);
+}
+
+template <typename L>
+LG_HD_INLINE L lane_min(L a, L b) {
+    return lane_select(a < b, a, b);
+}
+template <typename L>
+LG_HD_INLINE L lane_max(L a, L b) {
+    return lane_select(a > b, a, b);
+}
+
+}  // namespace lumigauss
