@@ -121,8 +121,9 @@ struct RasterState {
     std::vector<T> gradient_slots;
 
     // Binning scratch, kept so that a loop reusing one RasterState does not allocate it again per call.
-    std::vector<VisibleSurfel> visible_surfels;
+    std::vector<VisibleSurfel> visible_surfels;          // in surfel order
     std::vector<std::uint32_t> depth_keys, depth_order;  // visible_surfels indices, sorted front to back
+    std::vector<VisibleSurfel> sorted_surfels;           // visible_surfels in that order
     RadixSortScratch sort_scratch;
 
     mutable RasterPhaseTimes phase_ms;  // diagnostics only; the backward (const state) records its own

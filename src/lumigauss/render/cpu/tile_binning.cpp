@@ -36,36 +36,62 @@ struct Chunks {
 // positive; ties keep surfel order) and then scattered into their tiles in that order, so every tile's
 // list comes out sorted, deterministically, without sorting each tile. Each (surfel, tile) pair is an
 // emission, numbered surfel by surfel: the backward's gradient slots.
+//
+// Every pass reads its input in order: the visible surfels are compacted in surfel order, and gathered
+// once into depth order after the sort, so that the two passes over the depth order do not jump around
+// memory (with the records read through the sorted indices, they were a tenth of the forward).
 template <typename T>
 void bin_surfels_to_tiles(RasterState<T>& st) {
     const std::size_t n = st.footprints.size();
     const std::size_t num_tiles = std::size_t(st.tiles_x) * st.tiles_y;
 
-    // Emissions per surfel, prefix-summed; the visible surfels with their depths as sort keys.
-    st.emission_offset.resize(n + 1);
-    st.emission_offset[0] = 0;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i)
-            st.emission_offset[i + 1] = st.visible[i] ? tile_span(st.footprints[i].rect).count() : 0;
+    // Visible surfels in surfel order, compacted chunk by chunk: their depth keys, and what the passes
+    // below need of them (compact: the full projection state would be read at random after the sort).
+    // Then each surfel's first emission (prefix sums of the tile counts).
+    const Chunks surfel_chunks(n);
+    std::vector<std::uint32_t> chunk_visible(surfel_chunks.count + 1, 0),
+        chunk_emissions(surfel_chunks.count + 1, 0);
+    tbb::parallel_for(std::size_t(0), surfel_chunks.count, [&](std::size_t c) {
+        std::uint32_t visible = 0, emissions = 0;
+        for (std::size_t i = c * surfel_chunks.size; i < std::min(n, (c + 1) * surfel_chunks.size); ++i) {
+            if (!st.visible[i]) continue;
+            ++visible;
+            emissions += tile_span(st.footprints[i].rect).count();
+        }
+        chunk_visible[c + 1] = visible, chunk_emissions[c + 1] = emissions;
     });
-    // Visible surfels in surfel order: their depth keys, and what the passes below need of them, compact
-    // (they visit the surfels in depth order, i.e. at random: reading the full projection state there
-    // misses the cache for every surfel).
+    for (std::size_t c = 0; c < surfel_chunks.count; ++c) {
+        chunk_visible[c + 1] += chunk_visible[c];
+        chunk_emissions[c + 1] += chunk_emissions[c];
+    }
+    const std::size_t m = chunk_visible[surfel_chunks.count];
     std::vector<std::uint32_t>& keys = st.depth_keys;
     std::vector<std::uint32_t>& order = st.depth_order;  // indices into `visible`
     std::vector<VisibleSurfel>& visible = st.visible_surfels;
-    keys.clear(), order.clear(), visible.clear();
-    for (std::size_t i = 0; i < n; ++i) {
-        st.emission_offset[i + 1] += st.emission_offset[i];
-        if (!st.visible[i]) continue;
-        keys.push_back(std::bit_cast<std::uint32_t>(float(st.footprints[i].depth)));
-        order.push_back(std::uint32_t(visible.size()));
-        visible.push_back({tile_span(st.footprints[i].rect), std::uint32_t(i), st.emission_offset[i]});
-    }
+    keys.resize(m), order.resize(m), visible.resize(m);
+    st.emission_offset.resize(n + 1);
+    st.emission_offset[n] = chunk_emissions[surfel_chunks.count];
+    tbb::parallel_for(std::size_t(0), surfel_chunks.count, [&](std::size_t c) {
+        std::uint32_t k = chunk_visible[c], emission = chunk_emissions[c];
+        for (std::size_t i = c * surfel_chunks.size; i < std::min(n, (c + 1) * surfel_chunks.size); ++i) {
+            st.emission_offset[i] = emission;
+            if (!st.visible[i]) continue;
+            const TileSpan span = tile_span(st.footprints[i].rect);
+            keys[k] = std::bit_cast<std::uint32_t>(float(st.footprints[i].depth));
+            order[k] = k;
+            visible[k] = {span, std::uint32_t(i), emission};
+            emission += span.count();
+            ++k;
+        }
+    });
     radix_sort_pairs(keys, order, st.sort_scratch);
+    std::vector<VisibleSurfel>& sorted = st.sorted_surfels;
+    sorted.resize(m);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 4096), [&](const auto& r) {
+        for (std::size_t k = r.begin(); k != r.end(); ++k) sorted[k] = visible[order[k]];
+    });
 
     // Per chunk of the depth order and per tile: how many emissions; then where each chunk's go.
-    const std::size_t m = order.size();
     const Chunks chunks(m);
     std::vector<std::uint32_t> cursor(chunks.count * num_tiles, 0);
     const auto for_each_chunk = [&](auto&& body) {
@@ -75,7 +101,7 @@ void bin_surfels_to_tiles(RasterState<T>& st) {
     };
     for_each_chunk([&](std::uint32_t* counts, std::size_t first, std::size_t last) {
         for (std::size_t k = first; k < last; ++k) {
-            const TileSpan& s = visible[order[k]].span;
+            const TileSpan& s = sorted[k].span;
             for (int ty = s.ty0; ty <= s.ty1; ++ty)
                 for (int tx = s.tx0; tx <= s.tx1; ++tx) ++counts[std::size_t(ty) * st.tiles_x + tx];
         }
@@ -97,7 +123,7 @@ void bin_surfels_to_tiles(RasterState<T>& st) {
     st.entry_emission.resize(next);
     for_each_chunk([&](std::uint32_t* slot, std::size_t first, std::size_t last) {
         for (std::size_t k = first; k < last; ++k) {
-            const VisibleSurfel& v = visible[order[k]];
+            const VisibleSurfel& v = sorted[k];
             std::uint32_t e = v.first_emission;
             for (int ty = v.span.ty0; ty <= v.span.ty1; ++ty)
                 for (int tx = v.span.tx0; tx <= v.span.tx1; ++tx, ++e) {
