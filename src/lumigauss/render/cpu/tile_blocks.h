@@ -42,6 +42,7 @@ inline int block_y0(const raster::PixelRect& tile, int b) {
 struct BlockLists {
     std::uint32_t start[kTileBlocks + 1] = {};
     std::vector<std::uint32_t> items;
+    std::vector<std::uint32_t> masks;  // per entry of the tile: the blocks it overlaps (block_mask)
     std::span<const std::uint32_t> block(int b) const {
         return {items.data() + start[b], items.data() + start[b + 1]};
     }
@@ -65,33 +66,38 @@ LG_HD_INLINE void prefetch_entry(const RasterState<T>& st, std::uint32_t e, int 
     __builtin_prefetch(&st.entry_color[std::size_t(e) * channels]);
 }
 
+// The blocks of a tile whose pixels a rectangle (clipped to the tile) covers, as a bit mask: bit
+// 4 * by + bx is block (bx, by).
+static_assert(kBlocksX == 4 && kTileBlocks == 32, "one bit per block of a 16x16 tile");
+LG_HD_INLINE std::uint32_t block_mask(const raster::PixelRect& r, const raster::PixelRect& tile) {
+    const unsigned bx0 = unsigned(std::max(r.x0, tile.x0) - tile.x0) / kBlockWidth;
+    const unsigned by0 = unsigned(std::max(r.y0, tile.y0) - tile.y0) / kBlockHeight;
+    const unsigned bx1 = unsigned(std::min(r.x1, tile.x1) - tile.x0) / kBlockWidth;
+    const unsigned by1 = unsigned(std::min(r.y1, tile.y1) - tile.y0) / kBlockHeight;
+    const std::uint32_t columns = (2u << bx1) - (1u << bx0);                           // bits bx0..bx1
+    const std::uint32_t rows = (0x11111111u >> (4 * (7 - (by1 - by0)))) << (4 * by0);  // bit 4 by per row
+    return rows * columns;  // no carries: columns < 16
+}
+
+// A counting sort of the tile's entries into its blocks (each entry's block mask computed once).
 template <typename T>
-void build_block_lists(const RasterState<T>& st, int tile, const raster::PixelRect& tr, BlockLists& lists) {
-    struct Span {
-        int bx0, by0, bx1, by1;
-    };
-    const auto span_of = [&](const raster::PixelRect& r) {
-        return Span{
-            (std::max(r.x0, tr.x0) - tr.x0) / kBlockWidth, (std::max(r.y0, tr.y0) - tr.y0) / kBlockHeight,
-            (std::min(r.x1, tr.x1) - tr.x0) / kBlockWidth, (std::min(r.y1, tr.y1) - tr.y0) / kBlockHeight};
-    };
+LG_HD_INLINE void build_block_lists(const RasterState<T>& st, int tile, const raster::PixelRect& tr,
+                                    BlockLists& lists) {
     const std::uint32_t begin = st.tile_start[tile], end = st.tile_start[tile + 1];
+    lists.masks.resize(end - begin);
     std::uint32_t count[kTileBlocks] = {};
     for (std::uint32_t e = begin; e < end; ++e) {
-        const Span s = span_of(st.entry_footprint[e].rect);
-        for (int by = s.by0; by <= s.by1; ++by)
-            for (int bx = s.bx0; bx <= s.bx1; ++bx) ++count[by * kBlocksX + bx];
+        const std::uint32_t mask = block_mask(st.entry_footprint[e].rect, tr);
+        lists.masks[e - begin] = mask;
+        for (std::uint32_t m = mask; m; m &= m - 1) ++count[__builtin_ctz(m)];
     }
     lists.start[0] = 0;
     for (int b = 0; b < kTileBlocks; ++b) lists.start[b + 1] = lists.start[b] + count[b];
     lists.items.resize(lists.start[kTileBlocks]);
     std::uint32_t cursor[kTileBlocks];
     std::copy_n(lists.start, kTileBlocks, cursor);
-    for (std::uint32_t e = begin; e < end; ++e) {
-        const Span s = span_of(st.entry_footprint[e].rect);
-        for (int by = s.by0; by <= s.by1; ++by)
-            for (int bx = s.bx0; bx <= s.bx1; ++bx) lists.items[cursor[by * kBlocksX + bx]++] = e - begin;
-    }
+    for (std::uint32_t k = 0; k < end - begin; ++k)
+        for (std::uint32_t m = lists.masks[k]; m; m &= m - 1) lists.items[cursor[__builtin_ctz(m)]++] = k;
 }
 
 }  // namespace lumigauss::cpu
