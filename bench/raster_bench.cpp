@@ -60,25 +60,22 @@ void set_counters(benchmark::State& state, const RasterState<float>& st, const R
     state.counters["mean_alpha"] = alpha / pixels;
 }
 
-// Mean milliseconds per call of each phase, as counters.
+// Mean milliseconds per call of each phase, as counters. Every benchmark reports all of them (0 for the
+// phases it does not run): the CSV output (bench/run_raster_bench.sh) needs the same counters in every row.
 struct PhaseSums {
     RasterPhaseTimes sum;
     void add(const RasterPhaseTimes& t) {
         sum.project += t.project, sum.bin += t.bin, sum.gather += t.gather, sum.blend += t.blend;
         sum.backward_tiles += t.backward_tiles, sum.reduce += t.reduce;
     }
-    void report(benchmark::State& state, bool forward, bool backward) const {
+    void report(benchmark::State& state) const {
         const auto avg = [](double v) { return benchmark::Counter(v, benchmark::Counter::kAvgIterations); };
-        if (forward) {
-            state.counters["project_ms"] = avg(sum.project);
-            state.counters["bin_ms"] = avg(sum.bin);
-            state.counters["gather_ms"] = avg(sum.gather);
-            state.counters["blend_ms"] = avg(sum.blend);
-        }
-        if (backward) {
-            state.counters["bwd_tiles_ms"] = avg(sum.backward_tiles);
-            state.counters["reduce_ms"] = avg(sum.reduce);
-        }
+        state.counters["project_ms"] = avg(sum.project);
+        state.counters["bin_ms"] = avg(sum.bin);
+        state.counters["gather_ms"] = avg(sum.gather);
+        state.counters["blend_ms"] = avg(sum.blend);
+        state.counters["bwd_tiles_ms"] = avg(sum.backward_tiles);
+        state.counters["reduce_ms"] = avg(sum.reduce);
     }
 };
 
@@ -94,7 +91,7 @@ void BM_Forward(benchmark::State& state) {
         phases.add(st.phase_ms);
     }
     set_counters(state, st, img);
-    phases.report(state, true, false);
+    phases.report(state);
 }
 
 void BM_Backward(benchmark::State& state) {
@@ -115,7 +112,7 @@ void BM_Backward(benchmark::State& state) {
         phases.add(st.phase_ms);
     }
     set_counters(state, st, img);
-    phases.report(state, false, true);
+    phases.report(state);
 }
 
 void BM_ForwardBackward(benchmark::State& state) {
@@ -125,14 +122,17 @@ void BM_ForwardBackward(benchmark::State& state) {
     RasterImages<float> img;
     RasterImageGrads<float> g;
     SurfelGrads<float> grads;
+    PhaseSums phases;
     for (auto _ : state) {
         rasterize_forward_cpu(f.cam, f.surfels, RasterSettings<float>{}, st, img);
         g.color.assign(img.color.size(), 0.01f);
         g.alpha.assign(img.alpha.size(), 0.01f);
         rasterize_backward_cpu(f.surfels, st, g, grads);
         benchmark::DoNotOptimize(grads.means.data());
+        phases.add(st.phase_ms);
     }
     set_counters(state, st, img);
+    phases.report(state);
 }
 
 void sizes(benchmark::internal::Benchmark* b) {
