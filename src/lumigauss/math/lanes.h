@@ -5,6 +5,7 @@
 // dependent lookup). For a pack, comparisons give a per-lane mask and lane_select picks per lane; for a
 // scalar, a bool and ?:.
 #include <cmath>
+#include <cstdint>
 
 #include "lumigauss/math/hd.h"
 
@@ -34,6 +35,21 @@ struct LaneScalar<L> {
 };
 template <typename L>
 using lane_scalar_t = typename LaneScalar<L>::type;
+
+// The integer per lane (indices, counts): int for scalars, the pack's Index type for packs.
+template <typename L>
+struct LaneIndexOf {
+    using type = std::int32_t;
+};
+template <typename L>
+requires requires {
+    typename L::Index;
+}
+struct LaneIndexOf<L> {
+    using type = typename L::Index;
+};
+template <typename L>
+using LaneIndex = typename LaneIndexOf<L>::type;
 
 LG_HD_INLINE float lane_sqrt(float x) {
     return std::sqrt(x);

@@ -14,21 +14,6 @@
 
 namespace lumigauss::raster {
 
-// Integer per lane: sorted-entry indices and contributor counts.
-template <typename L>
-struct LaneIndexOf {
-    using type = std::int32_t;
-};
-template <typename L>
-requires requires {
-    typename L::Index;
-}
-struct LaneIndexOf<L> {
-    using type = typename L::Index;
-};
-template <typename L>
-using LaneIndex = typename LaneIndexOf<L>::type;
-
 // The running sums of the forward walk.
 template <typename L, int C>
 struct BlendPixel {
