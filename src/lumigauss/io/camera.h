@@ -14,7 +14,7 @@ struct Camera {
     int height = 0;
     double fx = 0, fy = 0, cx = 0, cy = 0;
     Mat3d rotation = Mat3d::identity();  // world-to-camera
-    Vec3d translation{};                  // world-to-camera
+    Vec3d translation{};                 // world-to-camera
 
     Vec3d center() const { return -(transpose(rotation) * translation); }
     Vec3d world_to_camera(Vec3d p) const { return rotation * p + translation; }

@@ -130,10 +130,9 @@ LG_HD_INLINE LaneMask<L> sphere_outside_view(Vec3<L> c, L radius_sq, L margin, c
         return (d < L(0)) & (d * d > radius_sq * (a_xy * a_xy + a_z * a_z));
     };
     const L fx(view.fx), fy(view.fy);
-    return in_front & (beyond(fx, L(view.cx) + margin, c.x) |
-                       beyond(-fx, L(V(view.width) - view.cx) + margin, c.x) |
-                       beyond(fy, L(view.cy) + margin, c.y) |
-                       beyond(-fy, L(V(view.height) - view.cy) + margin, c.y));
+    return in_front &
+           (beyond(fx, L(view.cx) + margin, c.x) | beyond(-fx, L(V(view.width) - view.cx) + margin, c.x) |
+            beyond(fy, L(view.cy) + margin, c.y) | beyond(-fy, L(V(view.height) - view.cy) + margin, c.y));
 }
 
 // Everything the projection decides about a surfel, before its reachable region is rounded to pixels.
@@ -149,10 +148,10 @@ struct ProjectionLanes {
 };
 
 // Projects a surfel (or several, one per lane) of reach `reach` = reach_rho(opacity), which the caller
-// computes (a logarithm per surfel, which no pack instruction does). Returns where it can be seen: false where it is behind
-// the near plane, exactly edge-on, too transparent to ever reach kAlphaMin, degenerate, or off-screen.
-// Written without early returns (every test folds into the mask), so that it runs on packs of surfels;
-// values in lanes that fail are unspecified.
+// computes (a logarithm per surfel, which no pack instruction does). Returns where it can be seen: false
+// where it is behind the near plane, exactly edge-on, too transparent to ever reach kAlphaMin, degenerate, or
+// off-screen. Written without early returns (every test folds into the mask), so that it runs on packs of
+// surfels; values in lanes that fail are unspecified.
 //
 // Two things are bounded separately. The screen low-pass filter is centred on the 3-sigma dual-conic box
 // centre, as in the reference implementation. The pixels it may touch are bounded exactly: where
@@ -230,8 +229,11 @@ LG_HD inline bool project_surfel(const SurfelGeometry<T>& g, T opacity, const Pi
                                  ProjectedSurfel<T>& out) {
     ProjectionLanes<T> p;
     const bool visible = project_surfel_lanes(g, reach_rho(opacity), view, p);
-    out = {p.tu, p.tv, p.tw, p.center, p.normal, p.flip, p.depth, p.reach, p.conic_center,
-           reachable_pixels(p.whole_image, p.lo, p.hi, view.width, view.height)};
+    out = {p.tu,           p.tv,
+           p.tw,           p.center,
+           p.normal,       p.flip,
+           p.depth,        p.reach,
+           p.conic_center, reachable_pixels(p.whole_image, p.lo, p.hi, view.width, view.height)};
     return visible && !out.rect.empty();
 }
 
