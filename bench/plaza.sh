@@ -8,8 +8,9 @@
 # checkpoint is resumed (so an interrupted benchmark continues where it stopped); otherwise it is trained.
 # --ablations adds the rows of the paper's ablation (Table 1, lower part), each a full training:
 #   no_stage1      without the unshadowed warm-up: transfer fitting from iteration 1 (warmup=1, then the preset's
-#                  stage-2 length: 500 iterations as officially, 100 in the fast preset), then shadowed. (Densification then runs in stage 3 until 15k: the official rule
-#                  accumulates statistics outside stage 2, i.e. before warmup or after start_shadowed.)
+#                  stage-2 length: 500 iterations as officially, 100 in the fast preset), then shadowed.
+#                  (Densification then runs in stage 3 until 15k: the official rule accumulates statistics
+#                  outside stage 2, i.e. before warmup or after start_shadowed.)
 #   no_cons_unsh   without l_consistency and the unshadowed reconstruction term in the last stage
 #                  (consistency_final_ratio=0, lambda_unshadowed_stage3=0; stage 2 still fits the transfer)
 #   no_range01     without l_[0,1] (lambda_range01=0)
