@@ -5,9 +5,12 @@
 // ones, every opacity), every pixel the kernel reaches must lie in a kept block.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <random>
+#include <set>
 
+#include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/render/cpu/tile_blocks.h"
 #include "lumigauss/render/surfel_kernel.h"
 #include "support/random_surfels.h"
@@ -85,7 +88,10 @@ CullingCounts check_random_splats(std::uint32_t seed) {
         // Scales from sub-pixel to metres, anisotropic.
         const double base = std::exp(std::log(0.002) + (std::log(3.0) - std::log(0.002)) * uni(rng));
         g.scale_u = base, g.scale_v = base * (0.05 + uni(rng));
-        const double opacity = std::exp(std::log(1.0 / 240) * uni(rng));
+        // Every opacity, including just above the 1/255 threshold (where the reach is tiny and the
+        // ellipse's size is a small difference of large terms).
+        const double opacity = i % 5 == 1 ? (1.0 / 255) * (1 + std::pow(10.0, -6 + 4 * uni(rng)))
+                                          : std::exp(std::log(1.0 / 240) * uni(rng));
         raster::ProjectedSurfel<double> p;
         if (!raster::project_surfel(g, opacity, view, p)) continue;
         ++n.splats;
@@ -112,6 +118,101 @@ TEST(RasterBlockCulling, EveryReachedPixelKeepsItsBlockInFloat) {
 TEST(RasterBlockCulling, EveryReachedPixelKeepsItsBlockInDouble) {
     const CullingCounts n = check_random_splats<double>(2);
     EXPECT_GT(n.culled, n.blocks / 10) << n.culled << " of " << n.blocks;
+}
+
+// Opacity just above the threshold: the kernel then reaches only the pixels next to the projected mean
+// (where u = v = 0) and the filter's tiny disk, which for a large, close, tilted surfel is centred
+// elsewhere (the 3-sigma box's centre). With the mean projected onto a pixel centre, that pixel is reached
+// and its block must stay, although the ellipse's size is then a tiny difference of large terms.
+TEST(RasterBlockCulling, BarelyOpaqueSurfelKeepsThePixelOfItsMean) {
+    const Camera cam = test_camera(160, 96);
+    const auto view = pinhole_view<double>(cam);
+    const Mat3d Rt = transpose(cam.rotation);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> uni(0, 1);
+    int checked = 0;
+    for (int i = 0; i < 400; ++i) {
+        const double z = 0.6 + 3 * uni(rng);
+        const int px = 20 + int(120 * uni(rng)), py = 10 + int(76 * uni(rng));
+        const Vec3d p_cam{(px + 0.5 - cam.cx) / cam.fx * z, (py + 0.5 - cam.cy) / cam.fy * z, z};
+        raster::SurfelGeometry<double> g;
+        g.mean = Rt * (p_cam - cam.translation);
+        const double tilt = 0.3 + 1.1 * uni(rng), turn = 6.283 * uni(rng);
+        const Vec3d axis{std::cos(turn), std::sin(turn), 0};
+        g.quat = {std::cos(tilt / 2), axis.x * std::sin(tilt / 2), axis.y * std::sin(tilt / 2), 0};
+        g.scale_u = 0.2 + 1.5 * uni(rng), g.scale_v = 0.05 + 0.5 * uni(rng);
+        const double opacity = (1.0 / 255) * (1 + std::pow(10.0, -7 + 3 * uni(rng)));
+        raster::ProjectedSurfel<double> p;
+        if (!raster::project_surfel(g, opacity, view, p)) continue;
+        CullingCounts n;
+        check_splat<float>(cam, p, opacity, n);
+        ASSERT_FALSE(HasFatalFailure()) << "surfel " << i << ", opacity - 1/255 = " << opacity - 1.0 / 255;
+        checked += n.reached_pixels > 0;
+    }
+    EXPECT_GT(checked, 100);  // the mean's pixel is reached in float for most of them
+}
+
+// The same property through the real forward (the per-instruction-set clones, eight entries' regions per
+// pack): in every block, every entry that clearly reaches a pixel before the pixel's last contributor
+// (alpha well above the threshold, so that the scalar evaluation here and the vector one there cannot
+// disagree) must be among the entries the forward composited into the block.
+TEST(RasterBlockCulling, ForwardCompositesEveryClearlyReachedPair) {
+    const Camera cam = test_camera(160, 96);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> uni(0, 1);
+    std::normal_distribution<double> gauss(0, 1);
+    const Mat3d Rt = transpose(cam.rotation);
+    const Vec3d eye = Rt * (-cam.translation);
+    SurfelBatch<float> s;
+    s.resize(2500);
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        const double z = 1 + 20 * uni(rng);
+        const Vec3d p_cam{(uni(rng) * 1.2 - 0.6) * cam.width / cam.fx * z,
+                          (uni(rng) * 1.2 - 0.6) * cam.height / cam.fy * z, z};
+        const Vec3d mean = Rt * (p_cam - cam.translation);
+        // Mostly nearly edge-on, as ground at a grazing angle.
+        const Vec3d ray = normalize(mean - eye);
+        const Vec3d side = normalize(cross(ray, Vec3d{gauss(rng), gauss(rng), gauss(rng)}));
+        const Vec3d normal = normalize(side + (0.03 + 0.5 * uni(rng) * uni(rng)) * ray);
+        const Vec3d u = normalize(cross(normal, Vec3d{0.3, 0.9, 0.1}));
+        const Vec4<double> q = quaternion_from_rotation(Mat3d::from_columns(u, cross(normal, u), normal));
+        for (int k = 0; k < 3; ++k) s.means[3 * i + k] = float(mean[k]);
+        for (int k = 0; k < 4; ++k) s.quats[4 * i + k] = float(q[k]);
+        s.scales[2 * i] = float(0.02 + 0.6 * uni(rng)), s.scales[2 * i + 1] = float(0.01 + 0.1 * uni(rng));
+        s.opacities[i] = float(0.02 + 0.4 * uni(rng));
+        for (int c = 0; c < 3; ++c) s.colors[3 * i + c] = float(uni(rng));
+    }
+    RasterState<float> st;
+    rasterize_forward_cpu(cam, s, RasterSettings<float>{}, st);
+    int pairs = 0;
+    for (int t = 0; t < st.tiles_x * st.tiles_y; ++t) {
+        const raster::PixelRect tile = cpu::tile_pixels(t, st.tiles_x, cam.width, cam.height);
+        const std::vector<std::uint32_t>& kept = st.block_entries[std::size_t(t)];
+        const std::uint32_t* start = &st.block_start[std::size_t(t) * (cpu::kTileBlocks + 1)];
+        for (int b = 0; b < cpu::kTileBlocks; ++b) {
+            const std::set<std::uint32_t> composited(kept.begin() + start[b], kept.begin() + start[b + 1]);
+            for (int i = 0; i < cpu::kLanes; ++i) {
+                const int x = cpu::block_x0(tile, b) + i % cpu::kBlockWidth;
+                const int y = cpu::block_y0(tile, b) + i / cpu::kBlockWidth;
+                if (x > tile.x1 || y > tile.y1) continue;
+                const std::uint32_t last = st.contributors[std::size_t(y) * cam.width + x];
+                for (std::uint32_t k = 0; k + 1 <= last; ++k) {
+                    const std::uint32_t e = st.tile_start[std::size_t(t)] + k;
+                    const raster::PixelRect& r = st.entry_footprint[e].rect;
+                    if (x < r.x0 || x > r.x1 || y < r.y0 || y > r.y1) continue;
+                    raster::SplatSample<float> smp;
+                    if (!raster::evaluate_splat(st.entry_splat[e], float(x) + 0.5f, float(y) + 0.5f, smp))
+                        continue;
+                    if (smp.alpha < 1.5f / 255 || smp.z < float(raster::kNearPlane) + 0.01f) continue;
+                    ++pairs;
+                    ASSERT_TRUE(composited.count(k))
+                        << "tile " << t << ", pixel (" << x << ", " << y << "): entry " << k
+                        << " reaches it but the forward did not composite it";
+                }
+            }
+        }
+    }
+    EXPECT_GT(pairs, 50000);
 }
 
 // The x-extent of the region in a band of rows, against the region itself sampled densely: nothing

@@ -1,9 +1,9 @@
 #pragma once
 // Scalar "lanes": the per-surfel and per-pixel formulas of the renderer are written once for a lane type L,
 // either a scalar (float or double: references, tests, one CUDA thread) or a pack of values computed at once
-// (the CPU backend's cpu::Pack8, which brings its own overloads of these functions, found by argument-
-// dependent lookup). For a pack, comparisons give a per-lane mask and lane_select picks per lane; for a
-// scalar, a bool and ?:.
+// (the CPU backend's cpu::Pack: eight pixels, or four surfels in double; it brings its own overloads of
+// these functions, found by argument-dependent lookup). For a pack, comparisons give a per-lane mask and
+// lane_select picks per lane; for a scalar, a bool and ?:.
 #include <cmath>
 #include <cstdint>
 

@@ -4,8 +4,9 @@
 // A pixel blends the samples of the surfels covering it in depth order: w_i = alpha_i T_i with
 // T_{i+1} = T_i (1 - alpha_i), into colour, expected depth, normal and the depth-distortion map, and records
 // the median depth and its contributor. The backward walks the same samples back to front, recovering
-// T_i = T_{i+1} / (1 - alpha_i) and keeping the blends of the samples behind, which is all dL/dalpha_i needs.
-// L is a lane type (see surfel_kernel.h): a scalar, or a pack of pixels on the CPU.
+// T_i = T_{i+1} / (1 - alpha_i) and keeping the blend of the samples behind (dotted with the incoming
+// gradients), which is all dL/dalpha_i needs.
+// L is a lane type (math/lanes.h): a scalar, or a pack of pixels on the CPU.
 #include <cstdint>
 
 #include "lumigauss/math/vec.h"
@@ -83,11 +84,11 @@ struct BlendSampleGrad {
 };
 
 // What un-blending a sample needs that does not depend on the walk (only on the sample and the pixel's
-// fixed gradients): its value in every map dotted with the map's gradient, and its mapped depth. Split
-// from unblend_sample so that a backend can compute it ahead of the walk.
+// fixed gradients): its value in every map dotted with the map's gradient, and its mapped depth. (Split
+// from unblend_sample so that its work can be scheduled apart from the walk's; the CPU backend measured it
+// best inside the walk.)
 template <typename L>
 struct SampleValues {
-    L z;          // the sample's depth (1 where it was not composited: any finite value does)
     L value_dot;  // sum over maps of (the sample's value) . dL/dmap
     L m, dm_dz;   // distortion depth and its derivative
 };
@@ -101,13 +102,13 @@ LG_HD_INLINE SampleValues<L> sample_values(const BlendPixelBackward<L, C>& s, La
     v.value_dot = s.g_alpha;
     for (int c = 0; c < C; ++c) v.value_dot += L(c < channels ? color[c] : T(0)) * s.g_color[c];
     for (int k = 0; k < 3; ++k) v.value_dot += L(normal[k]) * s.g_normal[k];
-    v.z = lane_select(composited, z_sample, L(1));
-    const DistortionDepth<L> mapped = distortion_depth_and_derivative(v.z);
+    const L z = lane_select(composited, z_sample, L(1));  // any finite depth where it was not composited
+    const DistortionDepth<L> mapped = distortion_depth_and_derivative(z);
     v.m = mapped.m;
     v.dm_dz = mapped.dm_dz;
     const L dist_w =
         (v.m * v.m * s.a_total + s.m2 - L(2) * v.m * s.m1) * s.g_dist;  // dL/dw of the distortion
-    v.value_dot += v.z * s.g_depth + dist_w;
+    v.value_dot += z * s.g_depth + dist_w;
     return v;
 }
 

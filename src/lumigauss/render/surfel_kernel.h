@@ -181,13 +181,9 @@ LG_HD inline void to_ray_transform_grad(Vec3<T> tu, Vec3<T> tv, Vec3<T> tw, Vec2
     g_opacity += g.opacity;
 }
 
-// Depth mapping used by the distortion loss: m = f/(f-n) (1 - n/z), NDC-like in [0, 1).
-template <typename T>
-LG_HD_INLINE T distortion_depth(T z) {
-    const T n = T(kNearPlane), f = T(kFarPlane);
-    return f / (f - n) * (T(1) - n / z);
-}
-// m and dm/dz = f n / ((f - n) z^2) from one reciprocal (the backward needs both).
+// Depth mapping used by the distortion loss: m = f/(f-n) (1 - n/z), NDC-like in [0, 1), and its derivative
+// dm/dz = f n / ((f - n) z^2), from one reciprocal (the forward and the backward both use this, so that
+// they agree on m to the bit).
 template <typename T>
 struct DistortionDepth {
     T m, dm_dz;
@@ -198,6 +194,10 @@ LG_HD_INLINE DistortionDepth<T> distortion_depth_and_derivative(T z) {
     const S n = S(kNearPlane), f = S(kFarPlane);
     const T inv_z = T(S(1)) / z;
     return {T(f / (f - n)) * (T(S(1)) - T(n) * inv_z), T(f * n / (f - n)) * inv_z * inv_z};
+}
+template <typename T>
+LG_HD_INLINE T distortion_depth(T z) {
+    return distortion_depth_and_derivative(z).m;
 }
 
 }  // namespace lumigauss::raster

@@ -92,7 +92,7 @@ template <typename L>
 LG_HD_INLINE ConicBox<L> conic_box(Vec3<L> tu, Vec3<L> tv, Vec3<L> tw, L c2, L d) {
     const Vec3<L> f{c2 / d, c2 / d, L(-1) / d};
     ConicBox<L> box;
-    box.center = {dot(f, hadamard(tu, tw)), dot(f, hadamard(tv, tw))};
+    box.center = conic_center(tu, tv, tw, c2, d);
     const L ex = box.center.x * box.center.x - dot(f, hadamard(tu, tu));
     const L ey = box.center.y * box.center.y - dot(f, hadamard(tv, tv));
     box.half_x = lane_sqrt(lane_max(ex, L(0)));

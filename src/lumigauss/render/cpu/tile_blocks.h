@@ -4,9 +4,10 @@
 // One block is one pack of eight lanes (lane_pack.h). The tile kernels walk each block on its own: its
 // pixels' running sums stay in registers while the block's own list of surfels streams past, instead of
 // each surfel being blended into tile-sized arrays in memory. A block stops as soon as all its pixels are
-// finished, and it visits only the surfels whose boxes overlap it: 4 x 2 blocks fit the small, roughly
-// round boxes of trained scenes better than tile rows do (on the benchmark scene, 10 % fewer lanes at
-// 200k surfels, 34 % fewer at 1M, where early stopping per block pays).
+// finished, and it visits only the surfels that can reach one of its pixels (their boxes overlap it, and
+// their exact reachable region too: splat_reach.h): 4 x 2 blocks fit the small, roughly round splats of
+// trained scenes better than tile rows do (on the benchmark scene, 10 % fewer lanes at 200k surfels, 34 %
+// fewer at 1M, where early stopping per block pays).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -40,12 +41,12 @@ inline int block_y0(const raster::PixelRect& tile, int b) {
     return tile.y0 + (b / kBlocksX) * kBlockHeight;
 }
 
-// Per block of one tile: the tile's entries (as indices from the tile's first entry) whose boxes overlap
+// Per block of one tile: the tile's entries (as indices from the tile's first entry) that may reach
 // the block, front to back.
 struct BlockLists {
     std::uint32_t start[kTileBlocks + 1] = {};
     std::vector<std::uint32_t> items;
-    std::vector<std::uint32_t> masks;  // per entry of the tile: the blocks it overlaps (block_mask)
+    std::vector<std::uint32_t> masks;  // per entry of the tile: the blocks it may reach
     std::span<const std::uint32_t> block(int b) const {
         return {items.data() + start[b], items.data() + start[b + 1]};
     }
@@ -54,7 +55,7 @@ struct BlockLists {
 // Scratch memory of one thread's tiles, reused from tile to tile.
 template <typename T>
 struct TileScratch {
-    BlockLists lists;      // forward: every entry overlapping each block
+    BlockLists lists;      // forward: every entry that may reach each block
     std::vector<T> grads;  // backward: per entry of the tile, its gradient sums
 };
 
