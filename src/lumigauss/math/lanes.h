@@ -76,5 +76,9 @@ template <typename L>
 LG_HD_INLINE L lane_max(L a, L b) {
     return lane_select(a > b, a, b);
 }
+template <typename L>
+LG_HD_INLINE L lane_abs(L x) {
+    return lane_max(x, -x);
+}
 
 }  // namespace lumigauss

@@ -33,7 +33,7 @@ LG_HD_INLINE SplatReach<L> make_splat_reach(Vec3<L> pa, Vec3<L> pb, Vec3<L> pd, 
     // The region depends on p only up to a common factor: scale it to order 1 first, so that the products
     // below (fourth powers of focal length x scale x depth) neither overflow nor underflow.
     const auto magnitude = [](Vec3<L> v) {
-        return lane_max(lane_max(lane_max(v.x, -v.x), lane_max(v.y, -v.y)), lane_max(v.z, -v.z));
+        return lane_max(lane_max(lane_abs(v.x), lane_abs(v.y)), lane_abs(v.z));
     };
     const L scale =
         L(1) / lane_max(lane_max(magnitude(pa), magnitude(pb)), lane_max(magnitude(pd), L(1e-30f)));
@@ -55,7 +55,7 @@ LG_HD_INLINE SplatReach<L> make_splat_reach(Vec3<L> pa, Vec3<L> pb, Vec3<L> pd, 
     // projected mean has p.xy = 0), but for R near 0 (opacity just above kAlphaMin) it is a small difference
     // of large terms. Elsewhere the rectangle stays.
     const L k = -(f + d * r.x + e * r.y);
-    const L k_terms = lane_max(f, -f) + lane_max(d * r.x, -(d * r.x)) + lane_max(e * r.y, -(e * r.y));
+    const L k_terms = lane_abs(f) + lane_abs(d * r.x) + lane_abs(e * r.y);
     definite = definite & (k > L(1e-3f) * k_terms) & lane_isfinite(k);
     r.definite = definite;
     const L safe_k = lane_select(definite, k, L(1));
@@ -79,9 +79,8 @@ LG_HD_INLINE LaneMask<L> reach_in_band(const SplatReach<S>& r, L dy0, L dy1, L& 
     const L hy(r.half_y), w0(r.half_width0), slope(r.slope), tr(r.t_right), hx(r.half_x);
     const L rf(r.filter_radius);
     // Margins for rounding, in both directions: relative to the sizes involved, plus a hundredth of a pixel.
-    const S abs_x = r.x < S(0) ? -r.x : r.x, abs_y = r.y < S(0) ? -r.y : r.y;
-    const L margin_x = L(S(1e-3) * (abs_x + r.half_x + r.filter_radius) + S(1e-2));
-    const L margin_y = L(S(1e-3) * (abs_y + r.half_y + r.filter_radius) + S(1e-2));
+    const L margin_x = L(S(1e-3) * (lane_abs(r.x) + r.half_x + r.filter_radius) + S(1e-2));
+    const L margin_y = L(S(1e-3) * (lane_abs(r.y) + r.half_y + r.filter_radius) + S(1e-2));
     dy0 = dy0 - margin_y, dy1 = dy1 + margin_y;
     const L t0 = lane_max(dy0 - L(r.y), -hy), t1 = lane_min(dy1 - L(r.y), hy);
     const auto in_ellipse = t0 <= t1;

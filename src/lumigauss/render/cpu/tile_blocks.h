@@ -9,6 +9,7 @@
 // trained scenes better than tile rows do (on the benchmark scene, 10 % fewer lanes at 200k surfels, 34 %
 // fewer at 1M, where early stopping per block pays).
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -140,7 +141,7 @@ LG_HD_INLINE void build_block_lists(const RasterState<T>& st, int tile, const ra
         for (int l = 0; l < kLanes; ++l) {
             const std::uint32_t e = std::min(first + std::uint32_t(l), end - 1);
             masks[l] = block_mask(st.entry_footprint[e].rect, tr);
-            refine = refine || __builtin_popcount(masks[l]) > 2;
+            refine = refine || std::popcount(masks[l]) > 2;
             const raster::SplatGeometry<T>& g = st.entry_splat[e];
             for (int k = 0; k < 3; ++k) pa[k].v[l] = g.pa[k], pb[k].v[l] = g.pb[k], pd[k].v[l] = g.pd[k];
             rho.v[l] = g.rho_cutoff;
@@ -148,7 +149,7 @@ LG_HD_INLINE void build_block_lists(const RasterState<T>& st, int tile, const ra
         if (refine) {
             const raster::SplatReach<P> reach = raster::make_splat_reach(pa, pb, pd, rho);
             for (int l = 0; l < kLanes && first + std::uint32_t(l) < end; ++l) {
-                if (__builtin_popcount(masks[l]) <= 2 || !reach.definite[l]) continue;
+                if (std::popcount(masks[l]) <= 2 || !reach.definite[l]) continue;
                 const raster::SplatReach<T> one{reach.x[l],
                                                 reach.y[l],
                                                 reach.half_x[l],
