@@ -2,10 +2,12 @@
 // backward: dL/d(means, quaternions, scales, opacities, colours) for a loss touching every output map.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/render/cpu/tile_backward.h"
 #include "support/random_surfels.h"
 
 namespace lumigauss {
@@ -135,6 +137,23 @@ TEST(RasterGradient, SixChannelsAndDenseOverlap) {
     o.min_scale = 0.3, o.max_scale = 0.9;  // many overlaps: long blending chains
     o.min_opacity = 0.5, o.max_opacity = 0.9;
     check_gradients(cam, random_surfels<double>(cam, 41, o), random_loss(cam, 6, 41, {}), {}, 2e-5);
+}
+
+// The backward walks a block's list in chunks of cpu::kUnblendChunk entries (tile_backward.h), handing
+// each chunk to a separate gradient pass. Faint, large, overlapping surfels make lists several chunks long,
+// so the walk's state must carry across chunk boundaries.
+TEST(RasterGradient, LongBlendingChainsSpanSeveralWalkChunks) {
+    const Camera cam = test_camera(20, 18);
+    RandomSceneOptions o;
+    o.count = 110;
+    o.min_scale = 0.6, o.max_scale = 1.2;
+    o.min_opacity = 0.03, o.max_opacity = 0.12;
+    const auto s = random_surfels<double>(cam, 57, o);
+    RasterState<double> st;
+    rasterize_forward_cpu(cam, s, RasterSettings<double>{}, st);
+    const std::uint32_t longest = *std::max_element(st.contributors.begin(), st.contributors.end());
+    ASSERT_GT(longest, 2 * cpu::kUnblendChunk) << "the scene should need at least three chunks";
+    check_gradients(cam, s, random_loss(cam, 3, 57, {}), {0.3, 0.1, 0.7}, 2e-5);
 }
 
 TEST(RasterGradient, AnyChannelCountUsesTheGeneralPath) {
