@@ -174,11 +174,13 @@ inline Pack8<T> lane_sums(const Pack8<T>* q) {
     const auto fold = [](Pack8<T> a, Pack8<T> b, IV lo, IV hi) {
         return Pack8<T>{__builtin_shuffle(a.v, b.v, lo) + __builtin_shuffle(a.v, b.v, hi)};
     };
-    // Level 1: pairs of neighbouring lanes; a's and b's interleaved.
-    const IV l1a{0, 8, 2, 10, 4, 12, 6, 14}, l1b{1, 9, 3, 11, 5, 13, 7, 15};
+    // Level 1: lanes two apart, a's and b's interleaved. These are the unpack-low / unpack-high patterns,
+    // one in-lane instruction each with AVX2 too (the neighbour pairs {0, 8, 2, 10, ...} took a permute
+    // and a blend each there).
+    const IV l1a{0, 8, 1, 9, 4, 12, 5, 13}, l1b{2, 10, 3, 11, 6, 14, 7, 15};
     const Pack8<T> s01 = fold(q[0], q[1], l1a, l1b), s23 = fold(q[2], q[3], l1a, l1b);
     const Pack8<T> s45 = fold(q[4], q[5], l1a, l1b), s67 = fold(q[6], q[7], l1a, l1b);
-    // Level 2: quarters. s01 = [a01 b01 a23 b23 a45 b45 a67 b67] -> [a0-3 b0-3 c0-3 d0-3 a4-7 b4-7 ...].
+    // Level 2: quarters. s01 = [a02 b02 a13 b13 a46 b46 a57 b57] -> [a0-3 b0-3 c0-3 d0-3 a4-7 b4-7 ...].
     const IV l2a{0, 1, 8, 9, 4, 5, 12, 13}, l2b{2, 3, 10, 11, 6, 7, 14, 15};
     const Pack8<T> t0 = fold(s01, s23, l2a, l2b), t1 = fold(s45, s67, l2a, l2b);
     // Level 3: halves.
@@ -189,6 +191,12 @@ inline Pack8<T> lane_sums(const Pack8<T>* q) {
 template <typename T>
 inline Pack8<T> load_pack(const T* p) {
     Pack8<T> r;
+    std::memcpy(&r.v, p, sizeof(r.v));
+    return r;
+}
+template <typename I>
+inline LaneInt<std::conditional_t<sizeof(I) == 4, float, double>, kLanes> load_lanes(const I* p) {
+    LaneInt<std::conditional_t<sizeof(I) == 4, float, double>, kLanes> r;
     std::memcpy(&r.v, p, sizeof(r.v));
     return r;
 }

@@ -30,38 +30,58 @@ T grad_at(const std::vector<T>& g, std::size_t i) {
 }
 
 // The backward walk's starting state of a block: what the forward left and the incoming gradients.
-// Lanes off the image keep contributors = 0 and zero gradients, so they never take part.
+// Lanes off the image keep contributors = 0 and zero gradients, so they never take part. The lanes are
+// gathered into plain arrays and loaded as whole packs: written lane by lane into the packs themselves,
+// GCC kept some of them in two 16-byte halves and re-assembled them in every iteration of the walk, a
+// store-forwarding stall per entry with AVX2.
 template <typename T, int C>
 LG_ALWAYS_INLINE void load_block(raster::BlendPixelBackward<Pack8<T>, C>& s, int x0, int y0,
                                  const raster::PixelRect& tr, int channels, const RasterState<T>& st,
                                  const RasterImageGrads<T>& g) {
+    using I = typename Int8<T>::I;
     const int width = st.view.width;
-    s.trans = Pack8<T>(T(1));
-    s.median_entry = Int8<T>(-1);
+    alignas(64) T trans[kLanes], bg_term[kLanes] = {}, g_color[C][kLanes] = {}, g_normal[3][kLanes] = {},
+                                 g_depth[kLanes] = {}, g_alpha[kLanes] = {}, g_dist[kLanes] = {},
+                                 g_median[kLanes] = {}, m1[kLanes] = {}, m2[kLanes] = {};
+    alignas(64) I contributors[kLanes] = {}, median_entry[kLanes];
     for (int i = 0; i < kLanes; ++i) {
+        trans[i] = T(1);
+        median_entry[i] = -1;
         const int x = x0 + i % kBlockWidth, y = y0 + i / kBlockWidth;
         if (x > tr.x1 || y > tr.y1) continue;
         const std::size_t pix = std::size_t(y) * width + x;
         const T t_final = st.final_transmittance[pix];
-        s.trans.v[i] = t_final;
-        s.a_total.v[i] = T(1) - t_final;
+        trans[i] = t_final;
         T dot_bg = 0;
         for (int c = 0; c < channels; ++c) {
             const T gc = grad_at(g.color, pix * channels + c);
-            s.g_color[c].v[i] = gc;
+            g_color[c][i] = gc;
             dot_bg += (st.background.empty() ? T(0) : st.background[c]) * gc;
         }
-        s.bg_term.v[i] = t_final * dot_bg;
-        for (int k = 0; k < 3; ++k) s.g_normal[k].v[i] = grad_at(g.normal, pix * 3 + k);
-        s.g_depth.v[i] = grad_at(g.depth, pix);
-        s.g_alpha.v[i] = grad_at(g.alpha, pix);
-        s.g_dist.v[i] = grad_at(g.distortion, pix);
-        s.g_median.v[i] = grad_at(g.median_depth, pix);
-        s.m1.v[i] = st.m1[pix];
-        s.m2.v[i] = st.m2[pix];
-        s.contributors.v[i] = typename Int8<T>::I(st.contributors[pix]);
-        s.median_entry.v[i] = st.median_entry[pix];
+        bg_term[i] = t_final * dot_bg;
+        for (int k = 0; k < 3; ++k) g_normal[k][i] = grad_at(g.normal, pix * 3 + k);
+        g_depth[i] = grad_at(g.depth, pix);
+        g_alpha[i] = grad_at(g.alpha, pix);
+        g_dist[i] = grad_at(g.distortion, pix);
+        g_median[i] = grad_at(g.median_depth, pix);
+        m1[i] = st.m1[pix];
+        m2[i] = st.m2[pix];
+        contributors[i] = I(st.contributors[pix]);
+        median_entry[i] = st.median_entry[pix];
     }
+    s.trans = load_pack(trans);
+    s.a_total = Pack8<T>(T(1)) - s.trans;
+    s.bg_term = load_pack(bg_term);
+    for (int c = 0; c < C; ++c) s.g_color[c] = load_pack(g_color[c]);
+    for (int k = 0; k < 3; ++k) s.g_normal[k] = load_pack(g_normal[k]);
+    s.g_depth = load_pack(g_depth);
+    s.g_alpha = load_pack(g_alpha);
+    s.g_dist = load_pack(g_dist);
+    s.g_median = load_pack(g_median);
+    s.m1 = load_pack(m1);
+    s.m2 = load_pack(m2);
+    s.contributors = load_lanes(contributors);
+    s.median_entry = load_lanes(median_entry);
 }
 
 // Adds the lane sums of one surfel's per-lane gradients `q` (kPadded packs, in SlotLayout order) to its

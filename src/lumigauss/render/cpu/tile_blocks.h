@@ -136,18 +136,25 @@ LG_HD_INLINE void build_block_lists(const RasterState<T>& st, int tile, const ra
     for (std::uint32_t first = begin; first < end; first += kLanes) {
         std::uint32_t masks[kLanes];
         bool refine = false;
-        Vec3<P> pa, pb, pd;
-        P rho;
         for (int l = 0; l < kLanes; ++l) {
             const std::uint32_t e = std::min(first + std::uint32_t(l), end - 1);
             masks[l] = block_mask(st.entry_footprint[e].rect, tr);
             refine = refine || std::popcount(masks[l]) > 2;
-            const raster::SplatGeometry<T>& g = st.entry_splat[e];
-            for (int k = 0; k < 3; ++k) pa[k].v[l] = g.pa[k], pb[k].v[l] = g.pb[k], pd[k].v[l] = g.pd[k];
-            rho.v[l] = g.rho_cutoff;
         }
         if (refine) {
-            const raster::SplatReach<P> reach = raster::make_splat_reach(pa, pb, pd, rho);
+            // The lanes are gathered in plain arrays (packs declared here were cleared with `rep stos`
+            // every eight entries, refined or not).
+            alignas(64) T rows[10][kLanes];  // pa, pb, pd (3 each), rho
+            for (int l = 0; l < kLanes; ++l) {
+                const raster::SplatGeometry<T>& g =
+                    st.entry_splat[std::min(first + std::uint32_t(l), end - 1)];
+                for (int k = 0; k < 3; ++k)
+                    rows[k][l] = g.pa[k], rows[3 + k][l] = g.pb[k], rows[6 + k][l] = g.pd[k];
+                rows[9][l] = g.rho_cutoff;
+            }
+            const auto row = [&](int r) { return load_pack(rows[r]); };
+            const Vec3<P> pa{row(0), row(1), row(2)}, pb{row(3), row(4), row(5)}, pd{row(6), row(7), row(8)};
+            const raster::SplatReach<P> reach = raster::make_splat_reach(pa, pb, pd, row(9));
             for (int l = 0; l < kLanes && first + std::uint32_t(l) < end; ++l) {
                 if (std::popcount(masks[l]) <= 2 || !reach.definite[l]) continue;
                 const raster::SplatReach<T> one{reach.x[l],
