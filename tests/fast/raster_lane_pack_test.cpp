@@ -2,10 +2,12 @@
 // patterns are easy to get subtly wrong: a lane summed twice, another never) and the whole-pack loads.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <random>
 
 #include "lumigauss/render/cpu/lane_pack.h"
+#include "lumigauss/render/surfel_kernel.h"
 
 namespace lumigauss::cpu {
 namespace {
@@ -44,6 +46,28 @@ TEST(LanePack, LoadLanesReadsEightIndicesInOrder) {
         EXPECT_EQ(a[i], narrow[i]);
         EXPECT_EQ(b[i], wide[i]);
     }
+}
+
+// The float kernel's exp (surfel_kernel.h, "about 1 ulp") against the double one over its whole range, on
+// scalars and on packs (the CPU tile kernels), which must agree to the bit: the forward and the backward
+// evaluate the same kernel in different loops.
+TEST(LanePack, KernelExpIsWithinTwoUlpOfExp) {
+    double worst_ulps = 0;
+    for (int i = 0; i <= 200000; ++i) {
+        const float x = -87.0f * float(i) / 200000.0f;
+        const float got = raster::kernel_exp(x);
+        const double exact = std::exp(double(x));
+        const double ulp = std::ldexp(1.0, std::ilogb(float(exact)) - 23);
+        worst_ulps = std::max(worst_ulps, std::abs(double(got) - exact) / ulp);
+        if (i % 8 == 0) {
+            Pack8<float> xs;
+            for (int l = 0; l < kLanes; ++l) xs.v[l] = x * float(l + 1) / 8.0f;
+            const Pack8<float> packed = raster::kernel_exp(xs);
+            for (int l = 0; l < kLanes; ++l) ASSERT_EQ(packed[l], raster::kernel_exp(xs[l])) << xs[l];
+        }
+    }
+    EXPECT_LE(worst_ulps, 2.0);
+    EXPECT_EQ(raster::kernel_exp(0.0f), 1.0f);
 }
 
 }  // namespace
