@@ -91,16 +91,21 @@ LG_ALWAYS_INLINE void add_lane_sums(const Pack8<T>* q, T* sums) {
     for (int j = 0; j < kPadded; j += kLanes) store_pack(sums + j, load_pack(sums + j) + lane_sums(q + j));
 }
 
-// What the backward walk hands an entry's gradient pass (per block lane).
+// What the backward walk hands an entry's gradient pass (per block lane). The walk's look-ahead evaluates
+// the kernel straight into the record, so nothing is copied on the way.
 template <typename P>
 struct UnblendedSample {
-    raster::SplatSample<P> smp;  // screen_branch also set where the pair was not composited
+    // The kernel sample, with two fields changed for the walk: alpha is 0 where the forward did not
+    // composite the pair, and screen_branch is also set there (the gradient pass reads neither alpha nor,
+    // where g_alpha = g_z = 0, the branch's values).
+    raster::SplatSample<P> smp;
     raster::BlendSampleGrad<P> grad;
     std::uint32_t k;  // the entry's place in the tile's list
 };
-// Records per pass: 12 KB in float, so that the gradient pass reads them back from L1. (16 and 32 measured
-// alike; 8 about 2 % slower.)
-inline constexpr std::uint32_t kUnblendChunk = 32;
+// Records per pass. The walk fills them in a ring of two chunks: its look-ahead writes the next chunk's
+// first record while the gradient pass has yet to read this chunk's. 2 x 16 records are 12 KB in float, so
+// that the gradient pass reads them back from L1. (Chunks of 16 and 32 measured alike; 8 about 2 % slower.)
+inline constexpr std::uint32_t kUnblendChunk = 16;
 
 template <typename T, int C>
 LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterState<T>& st,
@@ -116,9 +121,10 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
     const std::vector<std::uint32_t>& kept = st.block_entries[std::size_t(tile)];
     const std::uint32_t* const kept_start = &st.block_start[std::size_t(tile) * (kTileBlocks + 1)];
 
-    Unblended records[kUnblendChunk];  // here, not per block: its members' initialisers clear it
+    Unblended records[2 * kUnblendChunk];  // here, not per block: its members' initialisers clear it
     for (int b = 0; b < kTileBlocks; ++b) {
-        if (kept_start[b] == kept_start[b + 1]) continue;
+        const std::uint32_t first = kept_start[b], length = kept_start[b + 1] - first;
+        if (length == 0) continue;
         const int x0 = block_x0(tr, b), y0 = block_y0(tr, b);
         raster::BlendPixelBackward<P, C> s{};
         load_block(s, x0, y0, tr, channels, st, g);
@@ -130,63 +136,54 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
         // the lane sums, most of the work) has no chain between entries at all, so the processor overlaps
         // its iterations. (One loop doing both was latency-bound: an iteration filled the reorder window.)
         // Evaluating an entry's kernel does not depend on the walk either, so the walk runs it one entry
-        // ahead: the iteration that un-blends entry n also evaluates entry n - 1.
-        struct Evaluated {
-            raster::SplatSample<P> smp;
-            P a;  // alpha where the forward composited the pair, else 0
-        };
-        const auto evaluate = [&](std::uint32_t n) __attribute__((always_inline)) {
-            const std::uint32_t k = kept[n];
-            const std::uint32_t e = begin + k;
-            Evaluated r;
+        // ahead: the iteration that un-blends the j-th entry from the back also evaluates the next one.
+        const auto walked = [&](std::uint32_t j) -> std::uint32_t { return kept[first + length - 1 - j]; };
+        const auto record = [&](std::uint32_t j) -> Unblended& { return records[j % (2 * kUnblendChunk)]; };
+        const auto evaluate = [&](std::uint32_t j) __attribute__((always_inline)) {
+            Unblended& r = record(j);
+            r.k = walked(j);
+            const std::uint32_t e = begin + r.k;
             const auto composited = raster::evaluate_splat(st.entry_splat[e], cx, cy, r.smp) &
                                     lanes_in(st.entry_footprint[e].rect, px, py) &
-                                    (I(typename I::I(k + 1)) <= s.contributors);
-            r.a = lane_select(composited, r.smp.alpha, P(0));
-            return r;
+                                    (I(typename I::I(r.k + 1)) <= s.contributors);
+            r.smp.alpha = lane_select(composited, r.smp.alpha, P(0));
+            r.smp.screen_branch = r.smp.screen_branch | lane_not(composited);
         };
-        Evaluated next = evaluate(kept_start[b + 1] - 1);
-        for (std::uint32_t chunk_end = kept_start[b + 1]; chunk_end > kept_start[b];) {
-            const std::uint32_t chunk_begin =
-                chunk_end - std::min<std::uint32_t>(kUnblendChunk, chunk_end - kept_start[b]);
-            for (std::uint32_t n = chunk_end; n-- > chunk_begin;) {
-                const std::uint32_t k = kept[n];
-                const std::uint32_t e = begin + k;
-                if (n >= kept_start[b] + kPrefetchAhead)
-                    prefetch_entry(st, begin + kept[n - kPrefetchAhead], channels);
-                const Evaluated current = next;
-                if (n > kept_start[b]) next = evaluate(n - 1);
-                const P a = current.a;
-                const raster::SampleValues<P> values = raster::sample_values(
-                    s, a > P(0), current.smp.z, &st.entry_color[std::size_t(e) * channels], channels,
-                    st.entry_footprint[e].normal);
-                Unblended& r = records[chunk_end - 1 - n];
-                r.smp = current.smp;
-                r.smp.screen_branch = current.smp.screen_branch | (a <= P(0));
+        evaluate(0);
+        for (std::uint32_t chunk = 0; chunk < length; chunk += kUnblendChunk) {
+            const std::uint32_t chunk_end = std::min(length, chunk + kUnblendChunk);
+            for (std::uint32_t j = chunk; j < chunk_end; ++j) {
+                if (j + kPrefetchAhead < length)
+                    prefetch_entry(st, begin + walked(j + kPrefetchAhead), channels);
+                if (j + 1 < length) evaluate(j + 1);
+                Unblended& r = record(j);
+                const std::uint32_t e = begin + r.k;
+                const P a = r.smp.alpha;
+                const raster::SampleValues<P> values =
+                    raster::sample_values(s, a > P(0), r.smp.z, &st.entry_color[std::size_t(e) * channels],
+                                          channels, st.entry_footprint[e].normal);
                 r.grad = raster::unblend_sample(s, a, values, I(typename I::I(e)));
-                r.k = k;
             }
-            for (std::uint32_t i = 0; i < chunk_end - chunk_begin; ++i) {
-                const Unblended& r = records[i];
+            for (std::uint32_t j = chunk; j < chunk_end; ++j) {
+                const Unblended& r = record(j);
                 const raster::SplatGradTerms<P> t =
                     raster::splat_grad_terms(st.entry_splat[begin + r.k], cx, cy, r.smp, r.smp.screen_branch,
                                              r.grad.g_alpha, r.grad.g_z);
                 P q[kPadded];  // every entry assigned below (a `= {}` here costs a memset per iteration)
-                for (int j = 0; j < 3; ++j) {
-                    q[SlotLayout::kPa + j] = t.dx * t.g_p[j];
-                    q[SlotLayout::kPb + j] = t.dy * t.g_p[j];
-                    q[SlotLayout::kPd + j] = t.g_p[j];
-                    q[SlotLayout::kTw + j] = t.g_tw[j];
-                    q[SlotLayout::kNormal + j] = r.grad.w * s.g_normal[j];
+                for (int m = 0; m < 3; ++m) {
+                    q[SlotLayout::kPa + m] = t.dx * t.g_p[m];
+                    q[SlotLayout::kPb + m] = t.dy * t.g_p[m];
+                    q[SlotLayout::kPd + m] = t.g_p[m];
+                    q[SlotLayout::kTw + m] = t.g_tw[m];
+                    q[SlotLayout::kNormal + m] = r.grad.w * s.g_normal[m];
                 }
                 q[SlotLayout::kCenter] = t.g_center.x;
                 q[SlotLayout::kCenter + 1] = t.g_center.y;
                 q[SlotLayout::kOpacity] = t.g_opacity;
                 for (int c = 0; c < C; ++c) q[SlotLayout::kColor + c] = r.grad.w * s.g_color[c];
-                for (int j = SlotLayout::values(C); j < kPadded; ++j) q[j] = P(T(0));
+                for (int m = SlotLayout::values(C); m < kPadded; ++m) q[m] = P(T(0));
                 add_lane_sums<kPadded>(q, &scratch.grads[std::size_t(r.k) * kPadded]);
             }
-            chunk_end = chunk_begin;
         }
     }
     // Slots are indexed by emission (contiguous per surfel) so the per-surfel reduction streams.
