@@ -30,7 +30,7 @@ WorkCounts work_counts(const RasterState<T>& st) {
             w.pairs += double(cols) * rows;
         }
         cpu::build_block_lists(st, t, tile, lists);
-        w.lanes += 8.0 * double(lists.items.size());  // eight lanes per block
+        w.lanes += 8.0 * double(lists.total());  // eight lanes per block
     }
     return w;
 }

@@ -60,7 +60,7 @@ LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, RasterState<T>
     const std::uint32_t begin = st.tile_start[tile];
     // The entries each block composites, for the backward: at most every overlapping one.
     std::vector<std::uint32_t>& kept = st.block_entries[std::size_t(tile)];
-    kept.resize(scratch.lists.items.size());
+    kept.resize(scratch.lists.total());
     std::uint32_t* const kept_start = &st.block_start[std::size_t(tile) * (kTileBlocks + 1)];
     std::uint32_t num_kept = 0;
     for (int b = 0; b < kTileBlocks; ++b) {
