@@ -194,9 +194,10 @@ inline Pack8<T> load_pack(const T* p) {
     std::memcpy(&r.v, p, sizeof(r.v));
     return r;
 }
-template <typename I>
-inline LaneInt<std::conditional_t<sizeof(I) == 4, float, double>, kLanes> load_lanes(const I* p) {
-    LaneInt<std::conditional_t<sizeof(I) == 4, float, double>, kLanes> r;
+// Eight per-lane integers of T's width (Int8<T>::I), as load_pack reads eight values.
+template <typename T>
+inline Int8<T> load_lanes(const typename Int8<T>::I* p) {
+    Int8<T> r;
     std::memcpy(&r.v, p, sizeof(r.v));
     return r;
 }

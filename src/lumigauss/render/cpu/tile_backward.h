@@ -80,8 +80,8 @@ LG_ALWAYS_INLINE void load_block(raster::BlendPixelBackward<Pack8<T>, C>& s, int
     s.g_median = load_pack(g_median);
     s.m1 = load_pack(m1);
     s.m2 = load_pack(m2);
-    s.contributors = load_lanes(contributors);
-    s.median_entry = load_lanes(median_entry);
+    s.contributors = load_lanes<T>(contributors);
+    s.median_entry = load_lanes<T>(median_entry);
 }
 
 // Adds the lane sums of one surfel's per-lane gradients `q` (kPadded packs, in SlotLayout order) to its

@@ -148,6 +148,8 @@ LG_HD_INLINE void build_block_lists(const RasterState<T>& st, int tile, const ra
                                     BlockLists& lists) {
     const std::uint32_t begin = st.tile_start[tile], end = st.tile_start[tile + 1];
     std::uint32_t* const items = lists.reserve(end - begin);
+    // Counted here and copied into lists.size at the end: stores through `items` could alias the
+    // member array, which would make the compiler reload a counter after every store.
     std::uint32_t size[kTileBlocks] = {};
     // Eight entries at a time: their reachable regions are set up in one pack, one entry per lane.
     using P = Pack8<T>;
