@@ -48,7 +48,24 @@ TEST(LanePack, LoadLanesReadsEightIndicesInOrder) {
     }
 }
 
-// The float kernel's exp (surfel_kernel.h, "about 1 ulp") against the double one over its whole range, and
+// The table step of the float exp: 2^(n/8) for every n it is used for, as the nearest float (the exponent
+// step is exact), from scalars and packs alike.
+TEST(LanePack, Exp2EighthsIsTwoToTheNOverEightForEveryN) {
+    for (int n = -1008; n <= 0; ++n) {
+        const float shifted = float(n) + kExpRoundMagic;
+        const float expected = float(std::exp2(double(n) / 8.0));
+        ASSERT_EQ(lumigauss::exp2_eighths(shifted), expected) << n;
+        const Pack8<float> packed = exp2_eighths(Pack8<float>(shifted) - Pack8<float>(float(n % 8)) +
+                                                 Pack8<float>{Pack8<float>::V{0, 1, 2, 3, 4, 5, 6, 7}});
+        for (int l = 0; l < kLanes; ++l) {
+            const int m = n - n % 8 + l;
+            if (m > 0) continue;
+            ASSERT_EQ(packed[l], float(std::exp2(double(m) / 8.0))) << m;
+        }
+    }
+}
+
+// The float kernel's exp (surfel_kernel.h: at most 1.6 ulp) against the double one over its whole range, and
 // on packs (the CPU tile kernels) to the bit equal to the scalar formula it is written as.
 TEST(LanePack, KernelExpIsWithinTwoUlpOfExp) {
     double worst_ulps = 0;

@@ -13,6 +13,8 @@
 #include <cstring>
 #include <type_traits>
 
+#include "lumigauss/math/exp2_eighths.h"
+
 namespace lumigauss::cpu {
 
 inline constexpr int kLanes = 8;  // pixels per pack in the tile kernels
@@ -137,11 +139,15 @@ inline unsigned any_of_each(Mask8<T> a, Mask8<T> b) {
     return unsigned((w | (w >> 32)) & 3);
 }
 
-// 2^k for integer-valued k (the last step of kernel_exp), through the float's exponent bits.
-inline Pack8<float> exp2_integer(Pack8<float> k) {
+// 2^(n/8) per lane from n + kExpRoundMagic (kernel_exp; the scalar exp2_eighths in math/exp2_eighths.h): one
+// permutation of the eight-entry table (the index is taken modulo 8), the exponent raised by n >> 3.
+inline Pack8<float> exp2_eighths(Pack8<float> shifted) {
     using IV = Int8<float>::V;
-    const IV bits = (__builtin_convertvector(k.v, IV) + 127) << 23;
-    return {(Pack8<float>::V)bits};  // GCC vector cast: the same bits reinterpreted
+    const IV n = (IV)shifted.v - kExpRoundMagicBits;  // GCC vector cast: the same bits reinterpreted
+    const Pack8<float>::V table = {kExp2Eighths[0], kExp2Eighths[1], kExp2Eighths[2], kExp2Eighths[3],
+                                   kExp2Eighths[4], kExp2Eighths[5], kExp2Eighths[6], kExp2Eighths[7]};
+    const IV bits = (IV)__builtin_shuffle(table, n) + (n >> 3) * (1 << 23);
+    return {(Pack8<float>::V)bits};
 }
 
 // exp per lane in double (the reference path only).
