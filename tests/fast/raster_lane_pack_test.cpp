@@ -51,17 +51,15 @@ TEST(LanePack, LoadLanesReadsEightIndicesInOrder) {
 // The table step of the float exp: 2^(n/8) for every n it is used for, as the nearest float (the exponent
 // step is exact), from scalars and packs alike.
 TEST(LanePack, Exp2EighthsIsTwoToTheNOverEightForEveryN) {
-    for (int n = -1008; n <= 0; ++n) {
-        const float shifted = float(n) + kExpRoundMagic;
-        const float expected = float(std::exp2(double(n) / 8.0));
-        ASSERT_EQ(lumigauss::exp2_eighths(shifted), expected) << n;
-        const Pack8<float> packed = exp2_eighths(Pack8<float>(shifted) - Pack8<float>(float(n % 8)) +
-                                                 Pack8<float>{Pack8<float>::V{0, 1, 2, 3, 4, 5, 6, 7}});
-        for (int l = 0; l < kLanes; ++l) {
-            const int m = n - n % 8 + l;
-            if (m > 0) continue;
-            ASSERT_EQ(packed[l], float(std::exp2(double(m) / 8.0))) << m;
-        }
+    const auto expected = [](int n) { return float(std::exp2(double(n) / 8.0)); };
+    for (int n = -1008; n <= 0; ++n)
+        ASSERT_EQ(lumigauss::exp2_eighths(float(n) + kExpRoundMagic), expected(n)) << n;
+    for (int first = -1008; first <= 0; first += kLanes) {  // one n per lane: every table entry per pack
+        Pack8<float> shifted;
+        for (int l = 0; l < kLanes; ++l) shifted.v[l] = float(first + l) + kExpRoundMagic;
+        const Pack8<float> packed = exp2_eighths(shifted);
+        for (int l = 0; l < kLanes && first + l <= 0; ++l)
+            ASSERT_EQ(packed[l], expected(first + l)) << first + l;
     }
 }
 
