@@ -53,6 +53,7 @@ void set_counters(benchmark::State& state, const RasterState<float>& st, const R
     const double pixels = double(st.view.width) * st.view.height;
     double alpha = 0;
     for (float a : img.alpha) alpha += a;
+    state.counters["visible"] = double(std::count(st.visible.begin(), st.visible.end(), 1));
     state.counters["intersections"] = double(st.intersections());
     state.counters["pairs_per_pixel"] = pairs / pixels;
     state.counters["lanes_per_pixel"] = w.lanes / pixels;

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/util/error.h"
@@ -348,6 +349,49 @@ TEST(RasterProjection, OffScreenCullNeverDropsAContributingSurfel) {
     }
     EXPECT_GT(contributing, 300);  // the test sees both kinds in numbers
     EXPECT_GT(culled, 300);
+}
+
+TEST(RasterProjection, RasterizerKeepsExactlyTheSurfelsTheProjectionKeeps) {
+    // The CPU rasterizer culls in two steps: a first pass with a sphere that bounds a surfel of any opacity
+    // up to 1, then the exact projection on what is left. Scattered surfels around and behind the view,
+    // some too transparent, some fully opaque, a few with opacity above 1 (which the first pass must leave
+    // to the exact test): the rasterizer must keep exactly those project_surfel keeps.
+    const Camera cam = test_camera(48, 40);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> uni(0, 1);
+    SurfelBatch<double> batch;
+    batch.resize(3000);
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+        const double z = -1.0 + 10 * uni(rng);  // some behind the camera or before the near plane
+        const double px = (uni(rng) * 2.2 - 0.6) * cam.width, py = (uni(rng) * 2.2 - 0.6) * cam.height;
+        const double u = uni(rng);
+        const double opacity =
+            u < 0.1 ? 1.0 : (u < 0.15 ? 1.0 + uni(rng) : std::exp(std::log(1.0 / 300) * uni(rng)));
+        const double scale = std::exp(std::log(0.002) + (std::log(2.0) - std::log(0.002)) * uni(rng));
+        auto one =
+            one_surfel(cam, {(px - cam.cx) / cam.fx * z, (py - cam.cy) / cam.fy * z, z}, scale, opacity);
+        if (i % 2) {
+            for (int k = 0; k < 4; ++k) one.quats[std::size_t(k)] = uni(rng) - 0.5;
+            one.scales[1] = scale * (0.2 + uni(rng));
+        }
+        for (int k = 0; k < 3; ++k) batch.means[3 * i + k] = one.means[std::size_t(k)];
+        for (int k = 0; k < 4; ++k) batch.quats[4 * i + k] = one.quats[std::size_t(k)];
+        for (int k = 0; k < 2; ++k) batch.scales[2 * i + k] = one.scales[std::size_t(k)];
+        batch.opacities[i] = opacity;
+        for (int c = 0; c < 3; ++c) batch.colors[3 * i + c] = 0.5;
+    }
+    RasterState<double> st;
+    rasterize_forward_cpu(cam, batch, RasterSettings<double>{}, st);
+    const auto view = pinhole_view<double>(cam);
+    int kept = 0, dropped = 0;
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+        raster::ProjectedSurfel<double> p;
+        const bool exact = raster::project_surfel(batch.geometry(i), batch.opacities[i], view, p);
+        EXPECT_EQ(st.visible[i] != 0, exact) << "surfel " << i << ", opacity " << batch.opacities[i];
+        kept += exact, dropped += !exact;
+    }
+    EXPECT_GT(kept, 300);
+    EXPECT_GT(dropped, 300);
 }
 
 TEST(RasterProjection, TooTransparentSurfelsAreCulled) {

@@ -180,6 +180,27 @@ TEST(RasterGradient, SurfelCrossingTheCameraPlane) {
     check_gradients(cam, random_surfels<double>(cam, 51, o), random_loss(cam, 3, 51, {}), {}, 2e-5);
 }
 
+// The backward of the projection runs on eight surfels at a time, one per lane, each lane choosing how
+// its filter centre was placed: on the 3-sigma box's centre, or (disk crossing the camera plane) on the
+// projected mean. Near surfels large enough to cross the plane, mixed with ordinary ones in the same
+// groups of eight (and a group left part empty at the end).
+TEST(RasterGradient, MixedFilterCentresInOneGroupOfSurfels) {
+    const Camera cam = test_camera(32, 24);
+    RandomSceneOptions o;
+    o.count = 21;
+    o.min_depth = 0.6, o.max_depth = 4.0;
+    o.min_scale = 0.1, o.max_scale = 1.5;
+    const auto s = random_surfels<double>(cam, 71, o);
+    RasterState<double> st;
+    rasterize_forward_cpu(cam, s, RasterSettings<double>{}, st);
+    int conic = 0, mean = 0;
+    for (std::size_t i = 0; i < s.size(); ++i)
+        if (st.visible[i]) (st.projections[i].conic_center ? conic : mean) += 1;
+    ASSERT_GE(conic, 4);
+    ASSERT_GE(mean, 2);
+    check_gradients(cam, s, random_loss(cam, 3, 71, {}), {0.2, 0.4, 0.6}, 2e-5);
+}
+
 TEST(RasterGradient, TinySurfelsInTheScreenFilterBranch) {
     const Camera cam = test_camera(32, 24);
     RandomSceneOptions o;

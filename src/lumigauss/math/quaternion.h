@@ -37,7 +37,7 @@ LG_HD constexpr Vec4<T> rotation_from_unit_quaternion_vjp(Vec4<T> q, const Mat3<
 // Backward of normalize_quaternion: the raw parameter gets (I - q̂q̂ᵀ) g / |q|.
 template <typename T>
 LG_HD inline Vec4<T> normalize_quaternion_vjp(Vec4<T> raw, Vec4<T> g_unit) {
-    const T norm = std::sqrt(raw.x * raw.x + raw.y * raw.y + raw.z * raw.z + raw.w * raw.w);
+    const T norm = lane_sqrt(raw.x * raw.x + raw.y * raw.y + raw.z * raw.z + raw.w * raw.w);
     const Vec4<T> u{raw.x / norm, raw.y / norm, raw.z / norm, raw.w / norm};
     const T proj = u.x * g_unit.x + u.y * g_unit.y + u.z * g_unit.z + u.w * g_unit.w;
     return {(g_unit.x - proj * u.x) / norm, (g_unit.y - proj * u.y) / norm, (g_unit.z - proj * u.z) / norm,

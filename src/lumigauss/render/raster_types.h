@@ -93,7 +93,8 @@ template <typename T>
 struct RasterState {
     raster::PinholeView<T> view{};
     int tiles_x = 0, tiles_y = 0;
-    std::vector<raster::ProjectedSurfel<T>> projected;
+    std::vector<raster::ProjectionVjpInputs<T>>
+        projections;                               // per surfel: what the projection's backward reads
     std::vector<raster::SplatGeometry<T>> splats;  // per surfel: what the per-pixel kernel reads
     std::vector<SplatFootprint<T>> footprints;     // per surfel: box, normal, depth
     std::vector<std::uint8_t> visible;

@@ -252,52 +252,79 @@ struct SurfelGeometryGrad {
     T scale_u, scale_v;
 };
 
-// Backward of project_surfel for a visible surfel (recomputes what it needs from the inputs).
+// What the backward of the projection reads of a projected surfel (one per lane).
+template <typename L>
+struct ProjectionVjpInputs {
+    Vec3<L> tu, tv, tw;
+    Vec2<L> center;
+    L flip;
+    LaneMask<L> conic_center;
+};
+
+// Backward of project_surfel for visible surfels, one per lane (recomputes what it needs from the inputs).
+// Branch-free like the projection: both ways of placing the filter centre are differentiated and one is
+// selected per lane.
+template <typename L, typename V>
+LG_HD_INLINE SurfelGeometryGrad<L> project_surfel_vjp_lanes(const SurfelGeometry<L>& g,
+                                                            const PinholeView<V>& view,
+                                                            const ProjectionVjpInputs<L>& p,
+                                                            ProjectedSurfelGrad<L> grad) {
+    // 1. Filter centre -> rows of T. Near the boundary of the conic branch (d -> 0-) the centre runs off to
+    // infinity and its derivative with it; no pixel then uses the filter, so its gradient is exactly 0, and
+    // leaving the chain out (not multiplying by that 0) keeps 0 * inf from turning into NaN.
+    const L gx = grad.center.x, gy = grad.center.y;
+    const auto use_conic = p.conic_center & ((gx != L(0)) | (gy != L(0)));
+    {
+        const L c2 = L(kSigmaCutoff * kSigmaCutoff);
+        const Vec3<L> t{c2, c2, L(-1)};
+        const L d = conic_denominator(p.tw, c2);
+        // center.x = sum t_k tu_k tw_k / d,   d = sum t_k tw_k^2.
+        for (int k = 0; k < 3; ++k) {
+            const L tk_d = t[k] / d;
+            const L g_tu = gx * tk_d * p.tw[k];
+            const L g_tv = gy * tk_d * p.tw[k];
+            const L g_tw = gx * (tk_d * p.tu[k] - p.center.x * L(2) * tk_d * p.tw[k]) +
+                           gy * (tk_d * p.tv[k] - p.center.y * L(2) * tk_d * p.tw[k]);
+            grad.tu[k] += lane_select(use_conic, g_tu, L(0));
+            grad.tv[k] += lane_select(use_conic, g_tv, L(0));
+            grad.tw[k] += lane_select(use_conic, g_tw, L(0));
+        }
+    }
+    {
+        // The projected mean centres the filter: center = (tu.z, tv.z) / tw.z, tw.z beyond the near plane.
+        const auto use_mean = lane_not(p.conic_center);
+        const L inv_w = L(1) / p.tw.z;
+        grad.tu.z += lane_select(use_mean, gx * inv_w, L(0));
+        grad.tv.z += lane_select(use_mean, gy * inv_w, L(0));
+        grad.tw.z -= lane_select(use_mean, (gx * p.center.x + gy * p.center.y) * inv_w, L(0));
+    }
+    // 2. T = K M with M = [a b mean_cam] (columns): dL/dM = Kᵀ dL/dT.
+    const auto column_grad = [&](int c) -> Vec3<L> {
+        return {L(view.fx) * grad.tu[c], L(view.fy) * grad.tv[c],
+                L(view.cx) * grad.tu[c] + L(view.cy) * grad.tv[c] + grad.tw[c]};
+    };
+    const Mat3<V> Rt = transpose(view.rotation);
+    const Vec3<L> g_su_tu = rotate(Rt, column_grad(0));  // dL/d(s_u t_u) in world space
+    const Vec3<L> g_sv_tv = rotate(Rt, column_grad(1));
+    SurfelGeometryGrad<L> out;
+    out.mean = rotate(Rt, column_grad(2));
+
+    // 3. Scales, rotation columns, and the normal (flip is piecewise constant).
+    const Vec4<L> q = normalize_quaternion(g.quat);
+    const Mat3<L> R = rotation_from_unit_quaternion(q);
+    out.scale_u = dot(R.col(0), g_su_tu);
+    out.scale_v = dot(R.col(1), g_sv_tv);
+    const Mat3<L> gR = Mat3<L>::from_columns(g.scale_u * g_su_tu, g.scale_v * g_sv_tv, p.flip * grad.normal);
+    out.quat = normalize_quaternion_vjp(g.quat, rotation_from_unit_quaternion_vjp(q, gR));
+    return out;
+}
+
+// Backward of project_surfel for one visible surfel.
 template <typename T>
 LG_HD inline SurfelGeometryGrad<T> project_surfel_vjp(const SurfelGeometry<T>& g, const PinholeView<T>& view,
                                                       const ProjectedSurfel<T>& p,
-                                                      ProjectedSurfelGrad<T> grad) {
-    // 1. Filter centre -> rows of T. Near the boundary of the conic branch (d -> 0-) the centre runs off to
-    // infinity and its derivative with it; no pixel then uses the filter, so its gradient is exactly 0, and
-    // skipping the chain keeps 0 * inf from turning into NaN.
-    if (p.conic_center && (grad.center.x != T(0) || grad.center.y != T(0))) {
-        const T c2 = T(kSigmaCutoff * kSigmaCutoff);
-        const Vec3<T> t{c2, c2, T(-1)};
-        const T d = conic_denominator(p.tw, c2);
-        // center.x = sum t_k tu_k tw_k / d,   d = sum t_k tw_k^2.
-        const T gx = grad.center.x, gy = grad.center.y;
-        for (int k = 0; k < 3; ++k) {
-            const T tk_d = t[k] / d;
-            grad.tu[k] += gx * tk_d * p.tw[k];
-            grad.tv[k] += gy * tk_d * p.tw[k];
-            grad.tw[k] += gx * (tk_d * p.tu[k] - p.center.x * 2 * tk_d * p.tw[k]) +
-                          gy * (tk_d * p.tv[k] - p.center.y * 2 * tk_d * p.tw[k]);
-        }
-    } else if (!p.conic_center) {
-        const T inv_w = T(1) / p.tw.z;
-        grad.tu.z += grad.center.x * inv_w;
-        grad.tv.z += grad.center.y * inv_w;
-        grad.tw.z -= (grad.center.x * p.center.x + grad.center.y * p.center.y) * inv_w;
-    }
-    // 2. T = K M with M = [a b mean_cam] (columns): dL/dM = Kᵀ dL/dT.
-    const auto column_grad = [&](int c) -> Vec3<T> {
-        return {view.fx * grad.tu[c], view.fy * grad.tv[c],
-                view.cx * grad.tu[c] + view.cy * grad.tv[c] + grad.tw[c]};
-    };
-    const Mat3<T> Rt = transpose(view.rotation);
-    const Vec3<T> g_su_tu = Rt * column_grad(0);  // dL/d(s_u t_u) in world space
-    const Vec3<T> g_sv_tv = Rt * column_grad(1);
-    SurfelGeometryGrad<T> out;
-    out.mean = Rt * column_grad(2);
-
-    // 3. Scales, rotation columns, and the normal (flip is piecewise constant).
-    const Vec4<T> q = normalize_quaternion(g.quat);
-    const Mat3<T> R = rotation_from_unit_quaternion(q);
-    out.scale_u = dot(R.col(0), g_su_tu);
-    out.scale_v = dot(R.col(1), g_sv_tv);
-    const Mat3<T> gR = Mat3<T>::from_columns(g.scale_u * g_su_tu, g.scale_v * g_sv_tv, p.flip * grad.normal);
-    out.quat = normalize_quaternion_vjp(g.quat, rotation_from_unit_quaternion_vjp(q, gR));
-    return out;
+                                                      const ProjectedSurfelGrad<T>& grad) {
+    return project_surfel_vjp_lanes(g, view, {p.tu, p.tv, p.tw, p.center, p.flip, p.conic_center}, grad);
 }
 
 }  // namespace lumigauss::raster

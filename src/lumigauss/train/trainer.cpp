@@ -322,7 +322,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
         const std::size_t n = model.size();
         s.radii.assign(n, 0.0f);
         for (std::size_t i = 0; i < n; ++i) {
-            const auto& r = s.raster.projected[i].rect;
+            const auto& r = s.raster.footprints[i].rect;
             if (s.raster.visible[i] && !r.empty())
                 s.radii[i] = 0.5f * float(std::max(r.x1 - r.x0 + 1, r.y1 - r.y0 + 1));
         }

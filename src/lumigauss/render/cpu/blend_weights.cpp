@@ -48,7 +48,7 @@ void row_pairs(const RasterState<float>& st, int y, PixelPairs& out) {
 BlendWeights blend_weights(const RasterState<float>& st) {
     BlendWeights bw;
     bw.width = st.view.width, bw.height = st.view.height;
-    bw.surfels = st.projected.size();
+    bw.surfels = st.visible.size();
     std::vector<PixelPairs> rows(std::size_t(bw.height));
     tbb::parallel_for(0, bw.height, [&](int y) { row_pairs(st, y, rows[std::size_t(y)]); });
 
