@@ -3,6 +3,8 @@
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
+
 #include "bench_scene.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/render/cpu/tile_blocks.h"

@@ -394,6 +394,60 @@ TEST(RasterProjection, RasterizerKeepsExactlyTheSurfelsTheProjectionKeeps) {
     EXPECT_GT(dropped, 300);
 }
 
+TEST(RasterProjection, FirstCullIsTheExactTestAtOpacityOneAndBoundsItBelow) {
+    // may_reach_view (the rasterizer's first cull) against project_surfel_lanes, on surfels placed so that
+    // the opacity-1 bounding sphere lies within +-2 % of its radius from a side of the widened view or from
+    // the near plane: there the sphere test decides. At opacity 1 the two must agree exactly; below, the
+    // first cull may only keep more. A few NaN scales too (both then keep them).
+    const Camera cam = test_camera(48, 40);
+    const auto view = pinhole_view<double>(cam);
+    const auto opaque = raster::opaque_reach<double>();
+    const double margin = opaque.filter + 1;
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> uni(0, 1);
+    int agree_kept = 0, agree_culled = 0, below_kept_more = 0;
+    for (int i = 0; i < 4000; ++i) {
+        const double su = std::exp(std::log(0.002) + (std::log(2.0) - std::log(0.002)) * uni(rng));
+        const double sv = su * (0.2 + 0.8 * uni(rng));
+        const double radius = std::sqrt(opaque.disk_rho) * su;
+        const double delta = 0.04 * uni(rng) - 0.02;  // the sphere's distance beyond the plane: (1 + delta) r
+        Vec3d c{(uni(rng) - 0.5) * 4, (uni(rng) - 0.5) * 4, 0.5 + 9.5 * uni(rng)};
+        const int side = i % 5;
+        if (side == 4) {
+            c.z = raster::kNearPlane + radius * (1 + delta);
+        } else {
+            // Side planes through the camera centre, a.c >= 0 inside: a = (+-fx, 0, cx + m) or (0, +-fy, cy +
+            // m).
+            const bool horizontal = side < 2, low = side % 2 == 0;
+            const double f = horizontal ? cam.fx : cam.fy;
+            const double offset =
+                horizontal ? (low ? cam.cx : cam.width - cam.cx) : (low ? cam.cy : cam.height - cam.cy);
+            const double a_z = offset + margin, norm = std::sqrt(f * f + a_z * a_z);
+            const double along = (-radius * (1 + delta) * norm - a_z * c.z) / f;  // a.c = -(1 + delta) r |a|
+            (horizontal ? c.x : c.y) = low ? along : -along;
+        }
+        const double opacity = i % 2 ? 1.0 : std::exp(std::log(1.0 / 300) * uni(rng));
+        auto s = one_surfel(cam, c, su, opacity);
+        s.scales = {su, sv};
+        if (i % 97 == 0) s.scales[std::size_t(i % 3 == 0)] = std::nan("");
+        const auto g = s.geometry(0);
+        const bool may = raster::may_reach_view(g.mean, g.scale_u, g.scale_v, opacity, view, opaque);
+        raster::ProjectionLanes<double> lanes;
+        const bool exact = raster::project_surfel_lanes(g, raster::reach_rho(opacity), view, lanes);
+        if (exact) {
+            EXPECT_TRUE(may) << "case " << i << ": the first cull dropped a surfel the exact test keeps";
+        }
+        if (opacity == 1.0 && !std::isnan(g.scale_u) && !std::isnan(g.scale_v)) {
+            EXPECT_EQ(may, exact) << "case " << i << ", delta " << delta << ", side " << side;
+            (exact ? agree_kept : agree_culled) += may == exact;
+        }
+        below_kept_more += opacity < 1 && may && !exact;
+    }
+    EXPECT_GT(agree_kept, 400);  // both outcomes occur at the boundary, in numbers
+    EXPECT_GT(agree_culled, 400);
+    EXPECT_GT(below_kept_more, 100);  // the bound is loose below opacity 1: the exact test still has work
+}
+
 TEST(RasterProjection, TooTransparentSurfelsAreCulled) {
     const Camera cam = test_camera();
     raster::ProjectedSurfel<double> p;

@@ -201,6 +201,64 @@ TEST(RasterGradient, MixedFilterCentresInOneGroupOfSurfels) {
     check_gradients(cam, s, random_loss(cam, 3, 71, {}), {0.2, 0.4, 0.6}, 2e-5);
 }
 
+// The projection's backward on its own, for one surfel at a time (the scalar instantiation of the lane
+// code the rasterizer runs eight at a time): a random linear loss on every projected quantity the pixels
+// see (rows of the ray transform, filter centre, normal), against central differences in every input.
+TEST(RasterGradient, ProjectionBackwardMatchesFiniteDifferences) {
+    const Camera cam = test_camera(32, 24);
+    const auto view = pinhole_view<double>(cam);
+    RandomSceneOptions o;
+    o.count = 40;
+    o.min_depth = 0.6, o.max_depth = 5.0;  // both ways of centring the filter
+    o.min_scale = 0.05, o.max_scale = 1.5;
+    const auto s = random_surfels<double>(cam, 91, o);
+    std::mt19937 rng(92);
+    std::uniform_real_distribution<double> u(-1, 1);
+    int checked = 0, conic = 0, mean = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        raster::ProjectedSurfel<double> p;
+        if (!raster::project_surfel(s.geometry(i), s.opacities[i], view, p)) continue;
+        raster::ProjectedSurfelGrad<double> w;
+        for (int k = 0; k < 3; ++k)
+            w.tu[k] = u(rng), w.tv[k] = u(rng), w.tw[k] = u(rng), w.normal[k] = u(rng);
+        w.center = {u(rng), u(rng)};
+        const auto loss = [&](const raster::SurfelGeometry<double>& g) {
+            raster::ProjectedSurfel<double> q;
+            raster::project_surfel(g, s.opacities[i], view, q);
+            return dot(w.tu, q.tu) + dot(w.tv, q.tv) + dot(w.tw, q.tw) + dot(w.normal, q.normal) +
+                   w.center.x * q.center.x + w.center.y * q.center.y;
+        };
+        const auto analytic = raster::project_surfel_vjp(s.geometry(i), view, p, w);
+        double inputs[9], grads[9];
+        const auto g0 = s.geometry(i);
+        for (int k = 0; k < 3; ++k) inputs[k] = g0.mean[k], grads[k] = analytic.mean[k];
+        for (int k = 0; k < 4; ++k) inputs[3 + k] = g0.quat[k], grads[3 + k] = analytic.quat[k];
+        inputs[7] = g0.scale_u, inputs[8] = g0.scale_v, grads[7] = analytic.scale_u,
+        grads[8] = analytic.scale_v;
+        const auto geometry_of = [](const double* x) {
+            return raster::SurfelGeometry<double>{{x[0], x[1], x[2]}, {x[3], x[4], x[5], x[6]}, x[7], x[8]};
+        };
+        for (int k = 0; k < 9; ++k) {
+            double x[9];
+            std::copy_n(inputs, 9, x);
+            const double h = 1e-6 * std::max(1.0, std::abs(x[k]));
+            x[k] = inputs[k] + h;
+            const double lp = loss(geometry_of(x));
+            x[k] = inputs[k] - h;
+            const double lm = loss(geometry_of(x));
+            const double numeric = (lp - lm) / (2 * h);
+            EXPECT_NEAR(grads[k], numeric, 1e-5 * std::max({1.0, std::abs(numeric), std::abs(grads[k])}))
+                << "surfel " << i << ", input " << k
+                << (p.conic_center ? " (conic centre)" : " (projected mean)");
+            ++checked;
+        }
+        (p.conic_center ? conic : mean) += 1;
+    }
+    EXPECT_GE(conic, 5);
+    EXPECT_GE(mean, 2);
+    EXPECT_GE(checked, 9 * 10);
+}
+
 TEST(RasterGradient, TinySurfelsInTheScreenFilterBranch) {
     const Camera cam = test_camera(32, 24);
     RandomSceneOptions o;

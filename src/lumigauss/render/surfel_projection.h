@@ -217,6 +217,35 @@ LG_HD_INLINE LaneMask<L> project_surfel_lanes(const SurfelGeometry<L>& g, L reac
     return visible;
 }
 
+// What the most opaque surfel (opacity 1) can reach: the rho of its disk bound and the screen filter's
+// radius in pixels, as project_surfel_lanes computes them for reach = reach_rho(1).
+template <typename V>
+struct OpaqueReach {
+    V disk_rho, filter;
+};
+template <typename V>
+inline OpaqueReach<V> opaque_reach() {
+    const V reach = reach_rho(V(1));
+    return {lane_max(reach, V(kSigmaCutoff * kSigmaCutoff)), lane_sqrt(reach / V(kFilterInvSquare))};
+}
+
+// A cheap first cull, for surfels (one per lane) given as stored: false where project_surfel_lanes is
+// certainly false too. It makes the same near-plane, transparency and off-view tests without the rotation,
+// the conic or the opacity's logarithm: the off-view sphere is the one of a surfel of opacity 1 (`opaque`),
+// which bounds that of any opacity up to 1, since reach_rho grows with the opacity and sphere_outside_view
+// only gets harder to pass with a larger radius or margin. At opacity 1 the two tests are the same one.
+// Opacities above 1 are not bounded by it and are left to the exact test.
+template <typename L, typename V>
+LG_HD_INLINE LaneMask<L> may_reach_view(Vec3<L> mean, L scale_u, L scale_v, L opacity,
+                                        const PinholeView<V>& view, const OpaqueReach<V>& opaque) {
+    const Vec3<L> c = rotate(view.rotation, mean) +
+                      Vec3<L>{L(view.translation.x), L(view.translation.y), L(view.translation.z)};
+    const L sigma = lane_max(scale_u, scale_v);  // as project_surfel_lanes takes it (NaN where it is)
+    const auto off_view =
+        sphere_outside_view(c, L(opaque.disk_rho) * sigma * sigma, L(opaque.filter) + L(1), view);
+    return (opacity > L(kAlphaMin)) & (c.z > L(kNearPlane)) & lane_not((opacity <= L(1)) & off_view);
+}
+
 // The pixels of a projection (one lane's values): the whole image, or its reachable region rounded.
 template <typename T>
 LG_HD inline PixelRect reachable_pixels(bool whole_image, Vec2<T> lo, Vec2<T> hi, int width, int height) {

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <string>
 
 #include "lumigauss/render/cpu/multiversion.h"
@@ -41,38 +40,28 @@ LG_ALWAYS_INLINE bool store_projection(const ProjectedSurfel<double>& p, double 
     return true;
 }
 
-// Surfels [begin, end) that may be visible, into `ids`; returns how many. A cheap first pass, four surfels
-// at a time: the sphere about the mean that bounds everything a surfel of any opacity up to 1 can reach
-// (reach_rho(1) at the larger scale, and the screen filter's radius for it) lies behind the near plane or
-// beyond a side of the view. The same test as project_surfel_lanes makes with the surfel's own reach, on a
-// larger radius, so it never drops a surfel that one would keep; it spares the full projection (the
-// rotation, the conic, the logarithm of the opacity) most surfels off screen, a third of the benchmark's.
+// Surfels [begin, end) that may be visible (raster::may_reach_view), into `ids`; returns how many. Four at
+// a time: the full projection below is spared most surfels off screen (a third of the benchmark's).
 template <typename T>
 LG_ALWAYS_INLINE int may_be_visible(const SurfelBatch<T>& surfels, const raster::PinholeView<double>& view,
                                     std::size_t begin, std::size_t end, std::uint32_t* ids) {
     using P = cpu::Pack4d;
-    const double reach_max = std::max(raster::reach_rho(1.0), raster::kSigmaCutoff * raster::kSigmaCutoff);
-    const double filter_max = std::sqrt(raster::reach_rho(1.0) / raster::kFilterInvSquare);
+    const auto opaque = raster::opaque_reach<double>();
     int count = 0;
     for (std::size_t first = begin; first < end; first += P::kSize) {
         Vec3<P> mean;
-        P sigma, opacity;
+        P scale_u, scale_v, opacity;
         for (int l = 0; l < P::kSize; ++l) {
             const std::size_t i = std::min(first + std::size_t(l), end - 1);
             for (int k = 0; k < 3; ++k) mean[k].v[l] = double(surfels.means[3 * i + k]);
-            sigma.v[l] = double(std::max(surfels.scales[2 * i], surfels.scales[2 * i + 1]));
+            scale_u.v[l] = double(surfels.scales[2 * i]);
+            scale_v.v[l] = double(surfels.scales[2 * i + 1]);
             opacity.v[l] = double(surfels.opacities[i]);
         }
-        const Vec3<P> c = raster::rotate(view.rotation, mean) +
-                          Vec3<P>{P(view.translation.x), P(view.translation.y), P(view.translation.z)};
-        // Opacities above 1 are not bounded by reach_max: those go on to the exact test.
-        const auto bounded = opacity <= P(1.0);
-        const auto culled =
-            (opacity <= P(raster::kAlphaMin)) | lane_not(c.z > P(raster::kNearPlane)) |
-            (bounded & raster::sphere_outside_view(c, P(reach_max) * sigma * sigma, P(filter_max + 1), view));
+        const auto may = raster::may_reach_view(mean, scale_u, scale_v, opacity, view, opaque);
         for (int l = 0; l < P::kSize && first + std::size_t(l) < end; ++l) {
             ids[count] = std::uint32_t(first + std::size_t(l));
-            count += culled[l] == 0;
+            count += may[l] != 0;
         }
     }
     return count;
@@ -319,7 +308,7 @@ LG_ALWAYS_INLINE void reduce_range(const SurfelBatch<T>& surfels, const RasterSt
     int count = 0;
     const int stride = cpu::SlotLayout::stride(surfels.channels);
     for (std::size_t i = begin; i != end; ++i) {
-        if (i + kReduceAhead < end) {
+        if (i + kReduceAhead < end && st.visible[i + kReduceAhead]) {  // a visible surfel has a slot
             const std::size_t ahead = i + kReduceAhead;
             const char* projection = reinterpret_cast<const char*>(&st.projections[ahead]);
             __builtin_prefetch(projection);
