@@ -32,13 +32,14 @@ LG_HD_INLINE SplatReach<L> make_splat_reach(Vec3<L> pa, Vec3<L> pb, Vec3<L> pd, 
     const L R = rho_cutoff;
     // The region depends on p only up to a common factor: scale it to order 1 first, so that the products
     // below (fourth powers of focal length x scale x depth) neither overflow nor underflow.
-    const auto magnitude = [](Vec3<L> v) {
+    const auto magnitude = [](Vec3<L> v) LG_LAMBDA_INLINE {
         return lane_max(lane_max(lane_abs(v.x), lane_abs(v.y)), lane_abs(v.z));
     };
     const L scale =
         L(1) / lane_max(lane_max(magnitude(pa), magnitude(pb)), lane_max(magnitude(pd), L(1e-30f)));
     pa = scale * pa, pb = scale * pb, pd = scale * pd;
-    const auto form = [&](Vec3<L> u, Vec3<L> v) { return u.x * v.x + u.y * v.y - R * u.z * v.z; };
+    const auto form = [&](Vec3<L> u, Vec3<L> v)
+                          LG_LAMBDA_INLINE { return u.x * v.x + u.y * v.y - R * u.z * v.z; };
     const L a = form(pa, pa), b = form(pa, pb), c = form(pb, pb), d = form(pa, pd), e = form(pb, pd);
     const L f = form(pd, pd);
     const L det = a * c - b * b;
@@ -85,7 +86,7 @@ LG_HD_INLINE LaneMask<L> reach_in_band(const SplatReach<S>& r, L dy0, L dy1, L& 
     const L t0 = lane_max(dy0 - L(r.y), -hy), t1 = lane_min(dy1 - L(r.y), hy);
     const auto in_ellipse = t0 <= t1;
     const L inv_hy = L(1) / lane_max(hy, L(S(1e-30)));
-    const auto chord = [&](L t) {
+    const auto chord = [&](L t) LG_LAMBDA_INLINE {
         const L u = t * inv_hy;
         return w0 * lane_sqrt(lane_max(L(1) - u * u, L(0)));
     };

@@ -112,7 +112,8 @@ LG_HD_INLINE T reach_rho(T opacity) {
 // A world-to-camera rotation (of the view's scalar type V) applied to a vector of lanes.
 template <typename L, typename V>
 LG_HD_INLINE Vec3<L> rotate(const Mat3<V>& R, Vec3<L> v) {
-    const auto row = [&](int r) { return L(R(r, 0)) * v.x + L(R(r, 1)) * v.y + L(R(r, 2)) * v.z; };
+    const auto row = [&](int r)
+                         LG_LAMBDA_INLINE { return L(R(r, 0)) * v.x + L(R(r, 1)) * v.y + L(R(r, 2)) * v.z; };
     return {row(0), row(1), row(2)};
 }
 
@@ -125,7 +126,7 @@ LG_HD_INLINE LaneMask<L> sphere_outside_view(Vec3<L> c, L radius_sq, L margin, c
     const auto in_front = (front > L(0)) & (front * front > radius_sq);  // cannot reach the camera plane
     // Each side is a plane through the camera centre, a.c >= 0 on the visible side (u >= -margin,
     // u <= W + margin, and likewise for v). Beyond it by more than the radius: a.c < -r |a|.
-    const auto beyond = [&](L a_xy, L a_z, L xy) {
+    const auto beyond = [&](L a_xy, L a_z, L xy) LG_LAMBDA_INLINE {
         const L d = a_xy * xy + a_z * c.z;
         return (d < L(0)) & (d * d > radius_sq * (a_xy * a_xy + a_z * a_z));
     };
@@ -328,7 +329,7 @@ LG_HD_INLINE SurfelGeometryGrad<L> project_surfel_vjp_lanes(const SurfelGeometry
         grad.tw.z -= lane_select(use_mean, (gx * p.center.x + gy * p.center.y) * inv_w, L(0));
     }
     // 2. T = K M with M = [a b mean_cam] (columns): dL/dM = Kᵀ dL/dT.
-    const auto column_grad = [&](int c) -> Vec3<L> {
+    const auto column_grad = [&](int c) LG_LAMBDA_INLINE -> Vec3<L> {
         return {L(view.fx) * grad.tu[c], L(view.fy) * grad.tv[c],
                 L(view.cx) * grad.tu[c] + L(view.cy) * grad.tv[c] + grad.tw[c]};
     };

@@ -13,6 +13,7 @@
 #include "lumigauss/render/cpu/tile_binning.h"
 #include "lumigauss/render/cpu/tile_kernels.h"
 #include "lumigauss/util/error.h"
+#include "lumigauss/util/huge_pages.h"
 
 namespace lumigauss {
 namespace {
@@ -143,10 +144,11 @@ void project_surfels(const SurfelBatch<double>& surfels, RasterState<double>& st
 template <typename T>
 void project_all(const SurfelBatch<T>& surfels, RasterState<T>& st) {
     const std::size_t n = surfels.size();
-    st.projections.resize(n);
+    // Each written for the visible surfels only (and read only for them).
+    resize_for_overwrite(st.projections, n);
     st.visible.assign(n, 0);
-    st.splats.resize(n);
-    st.footprints.resize(n);
+    resize_for_overwrite(st.splats, n);
+    resize_for_overwrite(st.footprints, n);
     const raster::PinholeView<double> view{st.view.rotation.template cast<double>(),
                                            st.view.translation.template cast<double>(),
                                            double(st.view.fx),
@@ -169,9 +171,9 @@ template <typename T>
 void gather_entries(const SurfelBatch<T>& surfels, RasterState<T>& st) {
     const std::size_t m = st.intersections();
     const int C = surfels.channels;
-    st.entry_splat.resize(m);
-    st.entry_footprint.resize(m);
-    st.entry_color.resize(m * std::size_t(C));
+    resize_for_overwrite(st.entry_splat, m);
+    resize_for_overwrite(st.entry_footprint, m);
+    resize_for_overwrite(st.entry_color, m * std::size_t(C));
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 4096), [&](const auto& r) {
         for (std::size_t e = r.begin(); e != r.end(); ++e) {
             if (e + kGatherAhead < r.end()) {
@@ -260,9 +262,11 @@ LG_ALWAYS_INLINE void reduce_lanes(const SurfelBatch<T>& surfels, const RasterSt
         for (int k = 0; k < 4; ++k) in[kQuat + k][l] = surfels.quats[4 * i + k];
         in[kScale][l] = surfels.scales[2 * i], in[kScale + 1][l] = surfels.scales[2 * i + 1];
     }
-    const auto sum_of = [&](int k) { return cpu::load_pack(sums[k]); };
-    const auto input = [&](int k) { return cpu::load_pack(in[k]); };
-    const auto vec3 = [](auto get, int k) { return Vec3<P>{get(k), get(k + 1), get(k + 2)}; };
+    const auto sum_of = [&](int k) LG_LAMBDA_INLINE { return cpu::load_pack(sums[k]); };
+    const auto input = [&](int k) LG_LAMBDA_INLINE { return cpu::load_pack(in[k]); };
+    const auto vec3 = [](auto get, int k) LG_LAMBDA_INLINE {
+        return Vec3<P>{get(k), get(k + 1), get(k + 2)};
+    };
     raster::SplatGrad<P> sg;
     sg.pa = vec3(sum_of, Slot::kPa), sg.pb = vec3(sum_of, Slot::kPb), sg.pd = vec3(sum_of, Slot::kPd);
     sg.tw = vec3(sum_of, Slot::kTw);
@@ -399,7 +403,7 @@ void backward_into(const SurfelBatch<T>& surfels, const RasterState<T>& st, cons
     const std::size_t n = surfels.size();
     const int stride = cpu::SlotLayout::stride(surfels.channels);
     // Every slot is written by its tile (zeros for entries no pixel reached), so no clearing here.
-    slot_buffer.resize(st.intersections() * std::size_t(stride));
+    resize_for_overwrite(slot_buffer, st.intersections() * std::size_t(stride));
     T* slots = slot_buffer.data();
     const int num_tiles = st.tiles_x * st.tiles_y;
     tbb::enumerable_thread_specific<cpu::TileScratch<T>> scratch;

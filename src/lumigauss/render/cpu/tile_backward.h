@@ -137,9 +137,11 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
         // its iterations. (One loop doing both was latency-bound: an iteration filled the reorder window.)
         // Evaluating an entry's kernel does not depend on the walk either, so the walk runs it one entry
         // ahead: the iteration that un-blends the j-th entry from the back also evaluates the next one.
-        const auto walked = [&](std::uint32_t j) -> std::uint32_t { return kept[first + length - 1 - j]; };
-        const auto record = [&](std::uint32_t j) -> Unblended& { return records[j % (2 * kUnblendChunk)]; };
-        const auto evaluate = [&](std::uint32_t j) __attribute__((always_inline)) {
+        const auto walked = [&](std::uint32_t j)
+                                LG_LAMBDA_INLINE -> std::uint32_t { return kept[first + length - 1 - j]; };
+        const auto record = [&](std::uint32_t j)
+                                LG_LAMBDA_INLINE -> Unblended& { return records[j % (2 * kUnblendChunk)]; };
+        const auto evaluate = [&](std::uint32_t j) LG_LAMBDA_INLINE {
             Unblended& r = record(j);
             r.k = walked(j);
             const std::uint32_t e = begin + r.k;

@@ -172,7 +172,7 @@ LG_HD_INLINE void build_block_lists(const RasterState<T>& st, int tile, const ra
                     rows[k][l] = g.pa[k], rows[3 + k][l] = g.pb[k], rows[6 + k][l] = g.pd[k];
                 rows[9][l] = g.rho_cutoff;
             }
-            const auto row = [&](int r) { return load_pack(rows[r]); };
+            const auto row = [&](int r) LG_LAMBDA_INLINE { return load_pack(rows[r]); };
             const Vec3<P> pa{row(0), row(1), row(2)}, pb{row(3), row(4), row(5)}, pd{row(6), row(7), row(8)};
             const raster::SplatReach<P> reach = raster::make_splat_reach(pa, pb, pd, row(9));
             for (int l = 0; l < kLanes && first + std::uint32_t(l) < end; ++l) {

@@ -84,7 +84,7 @@ LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, RasterState<T>
             raster::SplatSample<P> smp;
             P alpha;  // 0 where the pair does not contribute
         };
-        const auto evaluate = [&](std::uint32_t k) __attribute__((always_inline)) {
+        const auto evaluate = [&](std::uint32_t k) LG_LAMBDA_INLINE {
             const std::uint32_t e = begin + k;
             Evaluated r;
             const auto hit = raster::evaluate_splat(st.entry_splat[e], cx, cy, r.smp) &

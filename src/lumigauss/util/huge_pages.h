@@ -1,0 +1,27 @@
+#pragma once
+// Large scratch buffers on transparent huge pages. The rasterizer's per-surfel and per-entry buffers run to
+// tens of MiB at a million surfels and are read and written at random (gathering the entries' records, the
+// backward's gradient slots): with 4 KiB pages nearly every such access also misses the TLB. Debian's
+// default ("madvise" mode) gives huge pages only to memory that asks for them.
+#include <cstddef>
+#include <vector>
+
+namespace lumigauss {
+
+// Asks for huge pages on the whole 2 MiB pages inside [data, data + bytes), for ranges of 4 MiB or more.
+// Only memory not yet touched gets them. Does nothing where the system has no such advice.
+void advise_huge_pages(void* data, std::size_t bytes);
+
+// v.resize(n) for a buffer that is entirely overwritten after it: when it must grow, its old contents are
+// dropped instead of copied, and the new memory is advised for huge pages before anything touches it.
+template <typename T, typename A>
+void resize_for_overwrite(std::vector<T, A>& v, std::size_t n) {
+    if (n > v.capacity()) {
+        std::vector<T, A>().swap(v);
+        v.reserve(n);
+        advise_huge_pages(v.data(), n * sizeof(T));
+    }
+    v.resize(n);
+}
+
+}  // namespace lumigauss
