@@ -136,6 +136,19 @@ LG_HD_INLINE LaneMask<L> sphere_outside_view(Vec3<L> c, L radius_sq, L margin, c
             beyond(fy, L(view.cy) + margin, c.y) | beyond(-fy, L(V(view.height) - view.cy) + margin, c.y));
 }
 
+// How far a surfel of reach `reach` = reach_rho(opacity) can be seen: its disk out to rho = disk_rho (the
+// reach, or 3 sigma, which bounds the filter centre), then the screen filter's radius in pixels, within
+// which rho_screen <= reach. The exact projection and the first cull (may_reach_view) both bound with it.
+template <typename L>
+struct ReachBound {
+    L disk_rho, filter;
+};
+template <typename L>
+LG_HD_INLINE ReachBound<L> reach_bound(L reach) {
+    return {lane_max(reach, L(kSigmaCutoff * kSigmaCutoff)),
+            lane_sqrt(lane_max(reach, L(0)) / L(kFilterInvSquare))};
+}
+
 // Everything the projection decides about a surfel, before its reachable region is rounded to pixels.
 template <typename L>
 struct ProjectionLanes {
@@ -167,13 +180,12 @@ LG_HD_INLINE LaneMask<L> project_surfel_lanes(const SurfelGeometry<L>& g, L reac
     const Vec3<L> mean_cam = rotate(view.rotation, g.mean) +
                              Vec3<L>{L(view.translation.x), L(view.translation.y), L(view.translation.z)};
     visible = visible & (mean_cam.z > L(kNearPlane));
-    // Everything the surfel can reach: its disk out to rho = reach (or 3 sigma, which bounds the filter
-    // centre), then the screen filter's radius around that in pixels (plus one for rounding).
+    // Everything the surfel can reach (reach_bound), plus one pixel for rounding.
     const L sigma = lane_max(g.scale_u, g.scale_v);
-    const L c2 = L(kSigmaCutoff * kSigmaCutoff);
-    const L disk_sq = lane_max(reach, c2) * sigma * sigma;
-    const L filter = lane_sqrt(lane_max(reach, L(0)) / L(kFilterInvSquare));  // rho_screen <= reach within
-    visible = visible & lane_not(sphere_outside_view(mean_cam, disk_sq, filter + L(1), view));
+    const ReachBound<L> bound = reach_bound(reach);
+    const L filter = bound.filter;
+    visible = visible &
+              lane_not(sphere_outside_view(mean_cam, bound.disk_rho * sigma * sigma, filter + L(1), view));
     const Mat3<L> R = rotation_from_unit_quaternion(normalize_quaternion(g.quat));
     const Vec3<L> a = rotate(view.rotation, g.scale_u * R.col(0));
     const Vec3<L> b = rotate(view.rotation, g.scale_v * R.col(1));
@@ -196,6 +208,7 @@ LG_HD_INLINE LaneMask<L> project_surfel_lanes(const SurfelGeometry<L>& g, L reac
     // per-pixel expansion (make_splat_geometry), where a far origin cancels catastrophically (a plaza
     // training run met a 1.2 m-deep surfel whose centre overflowed and made NaN gradients). Far outside
     // the image the filter cannot reach any pixel anyway, so the crossing-case centre is used there too.
+    const L c2 = L(kSigmaCutoff * kSigmaCutoff);
     const L d3 = conic_denominator(out.tw, c2);
     const Vec2<L> conic = conic_center(out.tu, out.tv, out.tw, c2, d3);
     const L margin = L(V(2) * V(view.width + view.height));
@@ -218,16 +231,10 @@ LG_HD_INLINE LaneMask<L> project_surfel_lanes(const SurfelGeometry<L>& g, L reac
     return visible;
 }
 
-// What the most opaque surfel (opacity 1) can reach: the rho of its disk bound and the screen filter's
-// radius in pixels, as project_surfel_lanes computes them for reach = reach_rho(1).
+// What the most opaque surfel (opacity 1) can reach: project_surfel_lanes' bound for reach = reach_rho(1).
 template <typename V>
-struct OpaqueReach {
-    V disk_rho, filter;
-};
-template <typename V>
-inline OpaqueReach<V> opaque_reach() {
-    const V reach = reach_rho(V(1));
-    return {lane_max(reach, V(kSigmaCutoff * kSigmaCutoff)), lane_sqrt(reach / V(kFilterInvSquare))};
+inline ReachBound<V> opaque_reach() {
+    return reach_bound(reach_rho(V(1)));
 }
 
 // A cheap first cull, for surfels (one per lane) given as stored: false where project_surfel_lanes is
@@ -238,7 +245,7 @@ inline OpaqueReach<V> opaque_reach() {
 // Opacities above 1 are not bounded by it and are left to the exact test.
 template <typename L, typename V>
 LG_HD_INLINE LaneMask<L> may_reach_view(Vec3<L> mean, L scale_u, L scale_v, L opacity,
-                                        const PinholeView<V>& view, const OpaqueReach<V>& opaque) {
+                                        const PinholeView<V>& view, const ReachBound<V>& opaque) {
     const Vec3<L> c = rotate(view.rotation, mean) +
                       Vec3<L>{L(view.translation.x), L(view.translation.y), L(view.translation.z)};
     const L sigma = lane_max(scale_u, scale_v);  // as project_surfel_lanes takes it (NaN where it is)
