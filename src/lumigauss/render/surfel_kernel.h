@@ -81,12 +81,12 @@ LG_HD inline SplatGeometry<T> make_splat_geometry(Vec3<T> tu, Vec3<T> tv, Vec3<T
     return make_splat_geometry(tu, tv, tw, center, opacity, reach_rho(opacity));
 }
 
-// Evaluates the surfel at pixel centre(s) (px, py). The result (true, or the lanes) says where the pair
-// contributes: not where the ray is parallel to the disk, the hit is nearer than the near plane, or
-// alpha < kAlphaMin. Written without early returns (every test folds into the result) so that it runs on
-// packs of pixels; a parallel ray makes u, v infinite or NaN, and every comparison below then fails.
+// The first half of evaluate_splat: where the ray of pixel centre(s) (px, py) hits the disk, which filter
+// branch wins, the depth (s.u, s.v, s.inv_pz, s.screen_branch, s.z) and the kernel's rho. Returns where the
+// pair is within reach: the ray is not parallel to the disk, rho <= rho_cutoff and the hit is not nearer
+// than the near plane (a parallel ray makes u, v infinite or NaN, and every comparison then fails).
 template <typename T, typename L>
-LG_HD_INLINE LaneMask<L> evaluate_splat(const SplatGeometry<T>& g, L px, L py, SplatSample<L>& s) {
+LG_HD_INLINE LaneMask<L> splat_hit(const SplatGeometry<T>& g, L px, L py, SplatSample<L>& s, L& rho) {
     const L dx = px - L(g.center.x), dy = py - L(g.center.y);
     const L p_x = dx * L(g.pa.x) + dy * L(g.pb.x) + L(g.pd.x);
     const L p_y = dx * L(g.pa.y) + dy * L(g.pb.y) + L(g.pd.y);
@@ -97,18 +97,39 @@ LG_HD_INLINE LaneMask<L> evaluate_splat(const SplatGeometry<T>& g, L px, L py, S
     const L rho_object = s.u * s.u + s.v * s.v;
     const L rho_screen = L(kFilterInvSquare) * (dx * dx + dy * dy);
     s.screen_branch = rho_screen < rho_object;
-    const L rho = lane_select(s.screen_branch, rho_screen, rho_object);
+    rho = lane_select(s.screen_branch, rho_screen, rho_object);
     // The screen branch uses the centre depth (the pinned rasterizer of the official code): far from the
     // disk, or at grazing angles, the intersection depth is meaningless.
     s.z = lane_select(s.screen_branch, L(g.tw.z), L(g.tw.x) * s.u + L(g.tw.y) * s.v + L(g.tw.z));
     // A ray parallel to the disk (p.z == 0) never contributes.
     const L rho_checked = lane_select(p_z != L(0), rho, L(std::numeric_limits<lane_scalar_t<L>>::infinity()));
-    const LaneMask<L> in_reach = rho_checked <= L(g.rho_cutoff);  // also false for NaN
-    s.gauss = kernel_exp(L(-0.5) * lane_select(in_reach, rho, L(0)));
-    const L a = L(g.opacity) * s.gauss;
+    return (rho_checked <= L(g.rho_cutoff)) & (s.z >= L(kNearPlane));  // also false for NaN
+}
+
+// The second half: the kernel's value s.gauss = exp(exponent) and alpha = min(kAlphaMax, opacity * gauss).
+// `exponent` is -rho / 2 where splat_hit found the pair in reach; elsewhere -infinity (gauss is then tiny
+// but finite, which the backward's zeroed terms need) or NaN. Returns where alpha >= kAlphaMin, which is
+// never where the exponent is NaN (for -infinity, the caller masks with splat_hit's result).
+template <typename T, typename L>
+LG_HD_INLINE LaneMask<L> splat_alpha(T opacity, L exponent, SplatSample<L>& s) {
+    s.gauss = kernel_exp(exponent);
+    const L a = L(opacity) * s.gauss;
     s.clamped = a > L(kAlphaMax);
     s.alpha = lane_select(s.clamped, L(kAlphaMax), a);
-    return (lane_select(in_reach, s.z, L(-1)) >= L(kNearPlane)) & (s.alpha >= L(kAlphaMin));
+    return s.alpha >= L(kAlphaMin);
+}
+
+// Evaluates the surfel at pixel centre(s) (px, py). The result (true, or the lanes) says where the pair
+// contributes: not where the ray is parallel to the disk, the hit is nearer than the near plane, or
+// alpha < kAlphaMin. Written without early returns (every test folds into the result) so that it runs on
+// packs of pixels. (The CPU forward runs its two halves in separate loops: tile_forward.h.)
+template <typename T, typename L>
+LG_HD_INLINE LaneMask<L> evaluate_splat(const SplatGeometry<T>& g, L px, L py, SplatSample<L>& s) {
+    L rho;
+    const LaneMask<L> in_reach = splat_hit(g, px, py, s, rho);
+    const L exponent =
+        lane_select(in_reach, L(-0.5) * rho, L(-std::numeric_limits<lane_scalar_t<L>>::infinity()));
+    return splat_alpha(g.opacity, exponent, s) & in_reach;
 }
 
 // Gradient accumulators of one surfel over many pixels, in the kernel's own variables: the per-pixel work

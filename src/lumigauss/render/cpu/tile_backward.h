@@ -9,6 +9,7 @@
 // does not depend on threads.
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/render/cpu/tile_forward.h"
@@ -102,9 +103,7 @@ struct UnblendedSample {
     raster::BlendSampleGrad<P> grad;
     std::uint32_t k;  // the entry's place in the tile's list
 };
-// Records per pass. The walk fills them in a ring of two chunks: its look-ahead writes the next chunk's
-// first record while the gradient pass has yet to read this chunk's. 2 x 16 records are 12 KB in float, so
-// that the gradient pass reads them back from L1. (Chunks of 16 and 32 measured alike; 8 about 2 % slower.)
+// Records per chunk of a block's loops: 16 records are 6 KB in float, read back from L1 by each loop.
 inline constexpr std::uint32_t kUnblendChunk = 16;
 
 template <typename T, int C>
@@ -121,7 +120,7 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
     const std::vector<std::uint32_t>& kept = st.block_entries[std::size_t(tile)];
     const std::uint32_t* const kept_start = &st.block_start[std::size_t(tile) * (kTileBlocks + 1)];
 
-    Unblended records[2 * kUnblendChunk];  // here, not per block: its members' initialisers clear it
+    Unblended records[kUnblendChunk];  // here, not per block: its members' initialisers clear it
     for (int b = 0; b < kTileBlocks; ++b) {
         const std::uint32_t first = kept_start[b], length = kept_start[b + 1] - first;
         if (length == 0) continue;
@@ -130,34 +129,43 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
         load_block(s, x0, y0, tr, channels, st, g);
         const I px = block_lane_x<T>() + I(x0), py = block_lane_y<T>() + I(y0);
         const P cx = pixel_centres(px), cy = pixel_centres(py);
-        // Two passes over chunks of the block's list. The walk (back to front) evaluates each entry's
-        // kernel and un-blends it: its only chain from entry to entry is the transmittance and the
-        // "behind" dot product. It records what the gradient pass needs; that pass (splat_grad_terms and
-        // the lane sums, most of the work) has no chain between entries at all, so the processor overlaps
-        // its iterations. (One loop doing both was latency-bound: an iteration filled the reorder window.)
-        // Evaluating an entry's kernel does not depend on the walk either, so the walk runs it one entry
-        // ahead: the iteration that un-blends the j-th entry from the back also evaluates the next one.
+        // Loops over chunks of the block's list. The first two evaluate the entries' kernels, in two
+        // halves (the hit up to rho, then the exponential and alpha), with no chain between entries, so
+        // that the processor overlaps consecutive entries' long chains (as in the forward:
+        // tile_forward.h). The walk (back to front) then un-blends them: its only chain from entry to
+        // entry is the transmittance and the "behind" dot product. It records what the gradient pass
+        // needs; that pass (splat_grad_terms and the lane sums, most of the work) has no chain between
+        // entries at all either. (One loop doing all of it was latency-bound: an iteration filled the
+        // reorder window.)
         const auto walked = [&](std::uint32_t j)
                                 LG_LAMBDA_INLINE -> std::uint32_t { return kept[first + length - 1 - j]; };
         const auto record = [&](std::uint32_t j)
-                                LG_LAMBDA_INLINE -> Unblended& { return records[j % (2 * kUnblendChunk)]; };
-        const auto evaluate = [&](std::uint32_t j) LG_LAMBDA_INLINE {
-            Unblended& r = record(j);
-            r.k = walked(j);
-            const std::uint32_t e = begin + r.k;
-            const auto composited = raster::evaluate_splat(st.entry_splat[e], cx, cy, r.smp) &
-                                    lanes_in(st.entry_footprint[e].rect, px, py) &
-                                    (I(typename I::I(r.k + 1)) <= s.contributors);
-            r.smp.alpha = lane_select(composited, r.smp.alpha, P(0));
-            r.smp.screen_branch = r.smp.screen_branch | lane_not(composited);
-        };
-        evaluate(0);
+                                LG_LAMBDA_INLINE -> Unblended& { return records[j % kUnblendChunk]; };
         for (std::uint32_t chunk = 0; chunk < length; chunk += kUnblendChunk) {
             const std::uint32_t chunk_end = std::min(length, chunk + kUnblendChunk);
             for (std::uint32_t j = chunk; j < chunk_end; ++j) {
                 if (j + kPrefetchAhead < length)
                     prefetch_entry(st, begin + walked(j + kPrefetchAhead), channels);
-                if (j + 1 < length) evaluate(j + 1);
+                Unblended& r = record(j);
+                r.k = walked(j);
+                const std::uint32_t e = begin + r.k;
+                P rho;
+                const auto reached = raster::splat_hit(st.entry_splat[e], cx, cy, r.smp, rho) &
+                                     lanes_in(st.entry_footprint[e].rect, px, py) &
+                                     (I(typename I::I(r.k + 1)) <= s.contributors);
+                // The exponent waits in the alpha field; -infinity where the pair was not composited.
+                r.smp.alpha = lane_select(reached, P(-0.5) * rho, P(-std::numeric_limits<T>::infinity()));
+            }
+            for (std::uint32_t j = chunk; j < chunk_end; ++j) {
+                Unblended& r = record(j);
+                const P exponent = r.smp.alpha;
+                const auto composited =
+                    raster::splat_alpha(st.entry_splat[begin + r.k].opacity, exponent, r.smp) &
+                    (exponent > P(-std::numeric_limits<T>::infinity()));
+                r.smp.alpha = lane_select(composited, r.smp.alpha, P(0));
+                r.smp.screen_branch = r.smp.screen_branch | lane_not(composited);
+            }
+            for (std::uint32_t j = chunk; j < chunk_end; ++j) {
                 Unblended& r = record(j);
                 const std::uint32_t e = begin + r.k;
                 const P a = r.smp.alpha;

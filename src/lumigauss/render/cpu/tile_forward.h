@@ -4,7 +4,10 @@
 // surfels are evaluated on all eight at once (surfel_kernel.h) and blended, front to back, until every
 // pixel of the block is finished. These functions are force-inlined into the per-instruction-set entry
 // points of tile_kernels_forward.cpp, so each is compiled for baseline x86-64, AVX2 and AVX-512.
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "lumigauss/render/cpu/lane_pack.h"
 #include "lumigauss/render/cpu/tile_blocks.h"
@@ -50,6 +53,9 @@ LG_ALWAYS_INLINE void store_block(const raster::BlendPixel<Pack8<T>, C>& s, int 
     }
 }
 
+// Entries per chunk of a block's forward loops (see render_tile_forward).
+inline constexpr std::size_t kEvaluateChunk = 8;
+
 template <typename T, int C>
 LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, RasterState<T>& st, RasterImages<T>& img,
                                           TileScratch<T>& scratch) {
@@ -78,35 +84,54 @@ LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, RasterState<T>
             store_block(s, x0, y0, tr, channels, st, img);
             continue;
         }
-        // As in the backward (tile_backward.h), the kernel of the next entry is evaluated while the
-        // current one is blended: the two chains are independent and overlap.
-        struct Evaluated {
-            raster::SplatSample<P> smp;
-            P alpha;  // 0 where the pair does not contribute
-        };
-        const auto evaluate = [&](std::uint32_t k) LG_LAMBDA_INLINE {
-            const std::uint32_t e = begin + k;
-            Evaluated r;
-            const auto hit = raster::evaluate_splat(st.entry_splat[e], cx, cy, r.smp) &
-                             lanes_in(st.entry_footprint[e].rect, px, py);
-            r.alpha = lane_select(hit, r.smp.alpha, P(0));
-            return r;
-        };
-        Evaluated next = evaluate(list[0]);
-        for (std::size_t n = 0; n < list.size(); ++n) {
-            const std::uint32_t k = list[n];
-            const std::uint32_t e = begin + k;
-            if (n + kPrefetchAhead < list.size())
-                prefetch_entry(st, begin + list[n + kPrefetchAhead], channels);
-            const Evaluated current = next;
-            if (n + 1 < list.size()) next = evaluate(list[n + 1]);
-            const auto composited = raster::blend_sample(
-                s, current.alpha, current.smp.z, &st.entry_color[std::size_t(e) * channels], channels,
-                st.entry_footprint[e].normal, I(typename I::I(e)), I(typename I::I(k + 1)));
-            const unsigned flags = any_of_each(composited, s.live > P(0));
-            kept[num_kept] = k;
-            num_kept += flags & 1;
-            if (!(flags & 2)) break;  // every pixel of the block is finished
+        // Three loops over chunks of the block's list: the kernels' hits (up to rho), their exponentials
+        // and alphas, then the blending. An entry's kernel (pixel -> hit -> rho -> exp -> alpha) is one
+        // long chain of dependent operations, but no entry's depends on another's, and the blend's chain
+        // from entry to entry is short. In one loop (even with the next entry's kernel evaluated while
+        // this one was blended) an iteration filled the processor's reorder window, and the loop waited on
+        // the chain; in loops of their own the halves of the kernel are short enough for the processor to
+        // overlap several entries. The results go through L1 as plain arrays (packs held in an array of
+        // packs were copied through general registers, in halves). A block that finishes inside a chunk
+        // has evaluated the rest of the chunk for nothing.
+        alignas(64) T chunk_alpha[kEvaluateChunk * kLanes], chunk_z[kEvaluateChunk * kLanes];
+        bool finished = false;
+        for (std::size_t chunk = 0; chunk < list.size() && !finished; chunk += kEvaluateChunk) {
+            const std::size_t chunk_end = std::min(list.size(), chunk + kEvaluateChunk);
+            for (std::size_t n = chunk; n < chunk_end; ++n) {
+                if (n + kPrefetchAhead < list.size())
+                    prefetch_entry(st, begin + list[n + kPrefetchAhead], channels);
+                const std::uint32_t e = begin + list[n];
+                raster::SplatSample<P> hit;  // only its depth is kept
+                P rho;
+                const auto reached = raster::splat_hit(st.entry_splat[e], cx, cy, hit, rho) &
+                                     lanes_in(st.entry_footprint[e].rect, px, py);
+                store_pack(&chunk_alpha[(n - chunk) * kLanes],
+                           lane_select(reached, P(-0.5) * rho, P(std::numeric_limits<T>::quiet_NaN())));
+                store_pack(&chunk_z[(n - chunk) * kLanes], hit.z);
+            }
+            for (std::size_t n = chunk; n < chunk_end; ++n) {
+                const std::uint32_t e = begin + list[n];
+                T* const alpha_at = &chunk_alpha[(n - chunk) * kLanes];
+                raster::SplatSample<P> smp;
+                const auto contributes =
+                    raster::splat_alpha(st.entry_splat[e].opacity, load_pack(alpha_at), smp);
+                store_pack(alpha_at, lane_select(contributes, smp.alpha, P(0)));
+            }
+            for (std::size_t n = chunk; n < chunk_end; ++n) {
+                const std::uint32_t k = list[n];
+                const std::uint32_t e = begin + k;
+                const auto composited = raster::blend_sample(
+                    s, load_pack(&chunk_alpha[(n - chunk) * kLanes]),
+                    load_pack(&chunk_z[(n - chunk) * kLanes]), &st.entry_color[std::size_t(e) * channels],
+                    channels, st.entry_footprint[e].normal, I(typename I::I(e)), I(typename I::I(k + 1)));
+                const unsigned flags = any_of_each(composited, s.live > P(0));
+                kept[num_kept] = k;
+                num_kept += flags & 1;
+                if (!(flags & 2)) {  // every pixel of the block is finished
+                    finished = true;
+                    break;
+                }
+            }
         }
         store_block(s, x0, y0, tr, channels, st, img);
     }
