@@ -78,10 +78,10 @@ struct TileScratch {
     std::vector<T> grads;  // backward: per entry of the tile, its gradient sums
 };
 
-// A block's loop does too much work per entry for the processor to run ahead to the next entry's loads on
-// its own (the next iteration does not fit in its reorder window), so each iteration first asks for the
-// data of the entry kPrefetchAhead places further down its list.
-inline constexpr std::size_t kPrefetchAhead = 2;
+// The block loops that read an entry's geometry first ask for the data of the entry kPrefetchAhead places
+// further down the list: the processor would not run ahead to those loads by itself early enough. (Six,
+// since the kernel loops' iterations are short; 2 and 6 measured alike, 6 by 2-5 % ahead in the backward.)
+inline constexpr std::size_t kPrefetchAhead = 6;
 template <typename T>
 LG_HD_INLINE void prefetch_entry(const RasterState<T>& st, std::uint32_t e, int channels) {
     __builtin_prefetch(&st.entry_splat[e]);
@@ -139,10 +139,17 @@ LG_HD_INLINE std::uint32_t reach_block_mask(const raster::SplatReach<T>& reach, 
     return mask;
 }
 
+// Entries whose bounding box spans more blocks of a tile than this have their exact reachable region
+// checked block by block (build_block_lists). For smaller ones the check (~100 instructions per entry)
+// costs more than the few blocks it could drop, each of which takes a block loop a few tens of cycles.
+// Forward tiles with 2 here / with 8 (bench/raster_bench, 1 thread, fastest of 3-6 rounds): 25.2 / 23.5 ms
+// at 200k surfels, 72.2 / 56.2 ms at 1M (small splats), 184 / 172 ms at 1280x720; the trained demo
+// model's forward (bench/train_bench) did not change beyond noise.
+inline constexpr int kRefineAboveBlocks = 8;
+
 // Sorts the tile's entries into its blocks' lists, in one pass (each entry's block mask computed once). An
-// entry spanning more than two blocks keeps only those its exact reachable region touches: for thin,
-// tilted splats most of the blocks of its bounding box. (Refining two-block entries too costs more than the
-// blocks it saves: 2 % of the benchmark's forward.)
+// entry spanning more than kRefineAboveBlocks blocks keeps only those its exact reachable region touches:
+// for thin, tilted splats most of the blocks of its bounding box.
 template <typename T>
 LG_HD_INLINE void build_block_lists(const RasterState<T>& st, int tile, const raster::PixelRect& tr,
                                     BlockLists& lists) {
@@ -159,7 +166,7 @@ LG_HD_INLINE void build_block_lists(const RasterState<T>& st, int tile, const ra
         for (int l = 0; l < kLanes; ++l) {
             const std::uint32_t e = std::min(first + std::uint32_t(l), end - 1);
             masks[l] = block_mask(st.entry_footprint[e].rect, tr);
-            refine = refine || std::popcount(masks[l]) > 2;
+            refine = refine || std::popcount(masks[l]) > kRefineAboveBlocks;
         }
         if (refine) {
             // The lanes are gathered in plain arrays (packs declared here were cleared with `rep stos`
@@ -176,7 +183,7 @@ LG_HD_INLINE void build_block_lists(const RasterState<T>& st, int tile, const ra
             const Vec3<P> pa{row(0), row(1), row(2)}, pb{row(3), row(4), row(5)}, pd{row(6), row(7), row(8)};
             const raster::SplatReach<P> reach = raster::make_splat_reach(pa, pb, pd, row(9));
             for (int l = 0; l < kLanes && first + std::uint32_t(l) < end; ++l) {
-                if (std::popcount(masks[l]) <= 2 || !reach.definite[l]) continue;
+                if (std::popcount(masks[l]) <= kRefineAboveBlocks || !reach.definite[l]) continue;
                 const raster::SplatReach<T> one{reach.x[l],
                                                 reach.y[l],
                                                 reach.half_x[l],
