@@ -18,8 +18,8 @@ namespace lumigauss::raster {
 // The running sums of the forward walk.
 template <typename L, int C>
 struct BlendPixel {
-    L live{};   // 1 while the pixel still blends; 0 once finished (or for a lane off the image)
-    L trans{};  // transmittance in front of the next sample: start at 1
+    LaneMask<L> live{};  // the pixel still blends (false once finished, and for a lane off the image)
+    L trans{};           // transmittance in front of the next sample: start at 1
     L color[C]{}, depth{}, normal[3]{}, distortion{};
     L m1{}, m2{};  // sum w m and sum w m^2 of the mapped depth m (distortion)
     L median{};
@@ -33,13 +33,15 @@ struct BlendPixel {
 template <typename L, int C, typename T>
 LG_HD_INLINE LaneMask<L> blend_sample(BlendPixel<L, C>& s, L alpha, L z, const T* color, int channels,
                                       Vec3<T> normal, LaneIndex<L> entry, LaneIndex<L> rank) {
-    const L a = alpha * s.live;
+    // A select, not a product with a 0/1 factor: it is on the chain of dependent operations from one sample
+    // to the next.
+    const L a = lane_select(s.live, alpha, L(0));
     const L t = s.trans;
     const L t_next = t * (L(1) - a);
     // A sample that would take T below the threshold finishes the pixel without being composited.
     // (a == 0 leaves t_next = t, which is at or above the threshold.)
     const auto stop = t_next < L(kTransmittanceMin);
-    s.live = lane_select(stop, L(0), s.live);
+    s.live = s.live & lane_not(stop);
     const L w = lane_select(stop, L(0), a * t);
     for (int c = 0; c < C; ++c) s.color[c] += w * L(c < channels ? color[c] : T(0));
     const auto composited = w > L(0);

@@ -104,6 +104,7 @@ struct UnblendedSample {
     std::uint32_t k;  // the entry's place in the tile's list
 };
 // Records per chunk of a block's loops: 16 records are 6 KB in float, read back from L1 by each loop.
+// (Chunks of 8 and 32 measured 6 % and 10 % slower.)
 inline constexpr std::uint32_t kUnblendChunk = 16;
 
 template <typename T, int C>

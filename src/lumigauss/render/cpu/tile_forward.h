@@ -76,7 +76,7 @@ LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, RasterState<T>
         const I px = block_lane_x<T>() + I(x0), py = block_lane_y<T>() + I(y0);  // pixel indices
         const P cx = pixel_centres(px), cy = pixel_centres(py);
         raster::BlendPixel<P, C> s{};
-        s.live = lane_select(lanes_in(tr, px, py), P(1), P(0));
+        s.live = lanes_in(tr, px, py);
         s.trans = P(1);
         s.median_entry = I(-1);
         const std::span<const std::uint32_t> list = scratch.lists.block(b);
@@ -124,7 +124,7 @@ LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, RasterState<T>
                     s, load_pack(&chunk_alpha[(n - chunk) * kLanes]),
                     load_pack(&chunk_z[(n - chunk) * kLanes]), &st.entry_color[std::size_t(e) * channels],
                     channels, st.entry_footprint[e].normal, I(typename I::I(e)), I(typename I::I(k + 1)));
-                const unsigned flags = any_of_each(composited, s.live > P(0));
+                const unsigned flags = any_of_each(composited, s.live);
                 kept[num_kept] = k;
                 num_kept += flags & 1;
                 if (!(flags & 2)) {  // every pixel of the block is finished
