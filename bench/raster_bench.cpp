@@ -14,9 +14,10 @@ namespace {
 
 // Work counts of one render: (pixel, surfel) pairs inside the surfels' boxes, and vector lanes: 8 per
 // (surfel, block of 4 x 2 pixels) pair whose box overlaps the block (tile_blocks.h), all of which a
-// forward without early termination would evaluate.
+// forward without early termination would evaluate, and 8 per pair the forward composited into at least
+// one pixel of the block, which the backward evaluates.
 struct WorkCounts {
-    double pairs = 0, lanes = 0;
+    double pairs = 0, lanes = 0, kept_lanes = 0;
 };
 
 template <typename T>
@@ -33,6 +34,8 @@ WorkCounts work_counts(const RasterState<T>& st) {
         }
         cpu::build_block_lists(st, t, tile, lists);
         w.lanes += 8.0 * double(lists.total());  // eight lanes per block
+        if (std::size_t(t) < st.block_entries.size())
+            w.kept_lanes += 8.0 * double(st.block_entries[t].size());
     }
     return w;
 }
@@ -59,6 +62,7 @@ void set_counters(benchmark::State& state, const RasterState<float>& st, const R
     state.counters["intersections"] = double(st.intersections());
     state.counters["pairs_per_pixel"] = pairs / pixels;
     state.counters["lanes_per_pixel"] = w.lanes / pixels;
+    state.counters["kept_lanes_per_pixel"] = w.kept_lanes / pixels;
     state.counters["pairs_per_s"] = benchmark::Counter(pairs, benchmark::Counter::kIsIterationInvariantRate);
     state.counters["mean_alpha"] = alpha / pixels;
 }
@@ -82,11 +86,17 @@ struct PhaseSums {
     }
 };
 
+// Each benchmark calls the rasterizer once before timing it: the state is reused from call to call, as in
+// training, and the first call's allocations (hundreds of MiB at 1M surfels, every page faulted in and
+// zeroed by the kernel) are not the steady state. At 1M surfels (320x240, 1 thread) that first call took
+// 1.5 s against 0.39 s for the next; the mean over the one or two iterations a short run makes included
+// it. (At 200k the buffers come back from malloc's heap already mapped, and it did not show.)
 void BM_Forward(benchmark::State& state) {
     const auto& f = fixture(int(state.range(0)), int(state.range(1)), int(state.range(2)));
     tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(3)));
     RasterState<float> st;
     RasterImages<float> img;
+    rasterize_forward_cpu(f.cam, f.surfels, RasterSettings<float>{}, st, img);  // warm-up (see above)
     PhaseSums phases;
     for (auto _ : state) {
         rasterize_forward_cpu(f.cam, f.surfels, RasterSettings<float>{}, st, img);
@@ -109,6 +119,7 @@ void BM_Backward(benchmark::State& state) {
     g.normal.assign(img.normal.size(), 0.01f);
     PhaseSums phases;
     SurfelGrads<float> grads;
+    rasterize_backward_cpu(f.surfels, st, g, grads);  // warm-up (see above BM_Forward)
     for (auto _ : state) {
         rasterize_backward_cpu(f.surfels, st, g, grads);
         benchmark::DoNotOptimize(grads.means.data());
@@ -126,11 +137,15 @@ void BM_ForwardBackward(benchmark::State& state) {
     RasterImageGrads<float> g;
     SurfelGrads<float> grads;
     PhaseSums phases;
-    for (auto _ : state) {
+    const auto forward_backward = [&] {
         rasterize_forward_cpu(f.cam, f.surfels, RasterSettings<float>{}, st, img);
         g.color.assign(img.color.size(), 0.01f);
         g.alpha.assign(img.alpha.size(), 0.01f);
         rasterize_backward_cpu(f.surfels, st, g, grads);
+    };
+    forward_backward();  // warm-up (see above BM_Forward)
+    for (auto _ : state) {
+        forward_backward();
         benchmark::DoNotOptimize(grads.means.data());
         phases.add(st.phase_ms);
     }
