@@ -92,8 +92,8 @@ LG_ALWAYS_INLINE void add_lane_sums(const Pack8<T>* q, T* sums) {
     for (int j = 0; j < kPadded; j += kLanes) store_pack(sums + j, load_pack(sums + j) + lane_sums(q + j));
 }
 
-// What the backward walk hands an entry's gradient pass (per block lane). The walk's look-ahead evaluates
-// the kernel straight into the record, so nothing is copied on the way.
+// What a block's loops hand on about one entry (per block lane): the kernel loops evaluate straight into
+// the record, the walk adds what the entry received, the gradient pass reads it all.
 template <typename P>
 struct UnblendedSample {
     // The kernel sample, with two fields changed for the walk: alpha is 0 where the forward did not
