@@ -107,9 +107,10 @@ LG_HD_INLINE LaneMask<L> splat_hit(const SplatGeometry<T>& g, L px, L py, SplatS
 }
 
 // The second half: the kernel's value s.gauss = exp(exponent) and alpha = min(kAlphaMax, opacity * gauss).
-// `exponent` is -rho / 2 where splat_hit found the pair in reach; elsewhere -infinity (gauss is then tiny
-// but finite, which the backward's zeroed terms need) or NaN. Returns where alpha >= kAlphaMin, which is
-// never where the exponent is NaN (for -infinity, the caller masks with splat_hit's result).
+// `exponent` is -rho / 2 where splat_hit found the pair in reach, else -infinity: gauss is then tiny but
+// finite (which the backward's zeroed terms need), and the caller masks the result with
+// `exponent > -infinity` (or splat_hit's own result). Never NaN: kernel_exp's float range reduction works on
+// the bits of its argument. Returns where alpha >= kAlphaMin.
 template <typename T, typename L>
 LG_HD_INLINE LaneMask<L> splat_alpha(T opacity, L exponent, SplatSample<L>& s) {
     s.gauss = kernel_exp(exponent);
