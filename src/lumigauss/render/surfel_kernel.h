@@ -106,18 +106,23 @@ LG_HD_INLINE LaneMask<L> splat_hit(const SplatGeometry<T>& g, L px, L py, SplatS
     return (rho_checked <= L(g.rho_cutoff)) & (s.z >= L(kNearPlane));  // also false for NaN
 }
 
+// What the second half takes as the exponent where the pair is out of reach: any positive value (no real
+// exponent -rho/2 is), so that the result is masked by the exponent's sign. Not -infinity: exp's underflow
+// times the opacity gives subnormal floats, each of which costs the processor a slow assist (it made the
+// tile loops 20 % slower); not NaN either: kernel_exp's float range reduction works on its argument's bits.
+inline constexpr float kUnreachedExponent = 1.0f;
+
 // The second half: the kernel's value s.gauss = exp(exponent) and alpha = min(kAlphaMax, opacity * gauss).
-// `exponent` is -rho / 2 where splat_hit found the pair in reach, else -infinity: gauss is then tiny but
-// finite (which the backward's zeroed terms need), and the caller masks the result with
-// `exponent > -infinity` (or splat_hit's own result). Never NaN: kernel_exp's float range reduction works on
-// the bits of its argument. Returns where alpha >= kAlphaMin.
+// `exponent` is -rho / 2 where splat_hit found the pair in reach, else kUnreachedExponent (gauss is then a
+// finite e, which the backward's zeroed terms need). Returns where the exponent is a real one and
+// alpha >= kAlphaMin.
 template <typename T, typename L>
 LG_HD_INLINE LaneMask<L> splat_alpha(T opacity, L exponent, SplatSample<L>& s) {
     s.gauss = kernel_exp(exponent);
     const L a = L(opacity) * s.gauss;
     s.clamped = a > L(kAlphaMax);
     s.alpha = lane_select(s.clamped, L(kAlphaMax), a);
-    return s.alpha >= L(kAlphaMin);
+    return (exponent <= L(0)) & (s.alpha >= L(kAlphaMin));
 }
 
 // Evaluates the surfel at pixel centre(s) (px, py). The result (true, or the lanes) says where the pair
@@ -128,9 +133,7 @@ template <typename T, typename L>
 LG_HD_INLINE LaneMask<L> evaluate_splat(const SplatGeometry<T>& g, L px, L py, SplatSample<L>& s) {
     L rho;
     const LaneMask<L> in_reach = splat_hit(g, px, py, s, rho);
-    const L exponent =
-        lane_select(in_reach, L(-0.5) * rho, L(-std::numeric_limits<lane_scalar_t<L>>::infinity()));
-    return splat_alpha(g.opacity, exponent, s) & in_reach;
+    return splat_alpha(g.opacity, lane_select(in_reach, L(-0.5) * rho, L(kUnreachedExponent)), s);
 }
 
 // Gradient accumulators of one surfel over many pixels, in the kernel's own variables: the per-pixel work

@@ -9,7 +9,6 @@
 // does not depend on threads.
 #include <algorithm>
 #include <cstdint>
-#include <limits>
 
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/render/cpu/tile_forward.h"
@@ -154,15 +153,14 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
                 const auto reached = raster::splat_hit(st.entry_splat[e], cx, cy, r.smp, rho) &
                                      lanes_in(st.entry_footprint[e].rect, px, py) &
                                      (I(typename I::I(r.k + 1)) <= s.contributors);
-                // The exponent waits in the alpha field; -infinity where the pair was not composited.
-                r.smp.alpha = lane_select(reached, P(-0.5) * rho, P(-std::numeric_limits<T>::infinity()));
+                // The exponent waits in the alpha field (kUnreachedExponent where the pair was not
+                // composited).
+                r.smp.alpha = lane_select(reached, P(-0.5) * rho, P(raster::kUnreachedExponent));
             }
             for (std::uint32_t j = chunk; j < chunk_end; ++j) {
                 Unblended& r = record(j);
-                const P exponent = r.smp.alpha;
                 const auto composited =
-                    raster::splat_alpha(st.entry_splat[begin + r.k].opacity, exponent, r.smp) &
-                    (exponent > P(-std::numeric_limits<T>::infinity()));
+                    raster::splat_alpha(st.entry_splat[begin + r.k].opacity, r.smp.alpha, r.smp);
                 r.smp.alpha = lane_select(composited, r.smp.alpha, P(0));
                 r.smp.screen_branch = r.smp.screen_branch | lane_not(composited);
             }

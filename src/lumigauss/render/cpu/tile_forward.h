@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
-#include <limits>
 
 #include "lumigauss/render/cpu/lane_pack.h"
 #include "lumigauss/render/cpu/tile_blocks.h"
@@ -106,16 +105,15 @@ LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, RasterState<T>
                 const auto reached = raster::splat_hit(st.entry_splat[e], cx, cy, hit, rho) &
                                      lanes_in(st.entry_footprint[e].rect, px, py);
                 store_pack(&chunk_alpha[(n - chunk) * kLanes],
-                           lane_select(reached, P(-0.5) * rho, P(-std::numeric_limits<T>::infinity())));
+                           lane_select(reached, P(-0.5) * rho, P(raster::kUnreachedExponent)));
                 store_pack(&chunk_z[(n - chunk) * kLanes], hit.z);
             }
             for (std::size_t n = chunk; n < chunk_end; ++n) {
                 const std::uint32_t e = begin + list[n];
                 T* const alpha_at = &chunk_alpha[(n - chunk) * kLanes];
-                const P exponent = load_pack(alpha_at);
                 raster::SplatSample<P> smp;
-                const auto contributes = raster::splat_alpha(st.entry_splat[e].opacity, exponent, smp) &
-                                         (exponent > P(-std::numeric_limits<T>::infinity()));
+                const auto contributes =
+                    raster::splat_alpha(st.entry_splat[e].opacity, load_pack(alpha_at), smp);
                 store_pack(alpha_at, lane_select(contributes, smp.alpha, P(0)));
             }
             for (std::size_t n = chunk; n < chunk_end; ++n) {
