@@ -46,8 +46,7 @@ TEST(SplatKernelHalves, EveryLaneStaysInNormalFloatsAndOutOfReachNeverCounts) {
         raster::SplatSample<Pack8<float>> hit, smp, whole;
         Pack8<float> rho;
         const auto reached = raster::splat_hit(g, px, py, hit, rho);
-        const Pack8<float> exponent =
-            lane_select(reached, Pack8<float>(-0.5f) * rho, Pack8<float>(raster::kUnreachedExponent));
+        const Pack8<float> exponent = raster::splat_exponent(rho, reached);
         const auto contributes = raster::splat_alpha(g.opacity, exponent, smp);
         const auto evaluated = raster::evaluate_splat(g, px, py, whole);
         for (int l = 0; l < kLanes; ++l) {

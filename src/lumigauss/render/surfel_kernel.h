@@ -112,10 +112,16 @@ LG_HD_INLINE LaneMask<L> splat_hit(const SplatGeometry<T>& g, L px, L py, SplatS
 // tile loops 20 % slower); not NaN either: kernel_exp's float range reduction works on its argument's bits.
 inline constexpr float kUnreachedExponent = 1.0f;
 
+// The exponent the second half takes: -rho / 2 where `reached` (splat_hit's result, narrowed by whatever
+// else the caller knows), else kUnreachedExponent.
+template <typename L>
+LG_HD_INLINE L splat_exponent(L rho, LaneMask<L> reached) {
+    return lane_select(reached, L(-0.5) * rho, L(kUnreachedExponent));
+}
+
 // The second half: the kernel's value s.gauss = exp(exponent) and alpha = min(kAlphaMax, opacity * gauss).
-// `exponent` is -rho / 2 where splat_hit found the pair in reach, else kUnreachedExponent (gauss is then a
-// finite e, which the backward's zeroed terms need). Returns where the exponent is a real one and
-// alpha >= kAlphaMin.
+// `exponent` is splat_exponent's (out of reach, gauss is a finite e, which the backward's zeroed terms
+// need). Returns where the exponent is a real one and alpha >= kAlphaMin.
 template <typename T, typename L>
 LG_HD_INLINE LaneMask<L> splat_alpha(T opacity, L exponent, SplatSample<L>& s) {
     s.gauss = kernel_exp(exponent);
@@ -133,7 +139,7 @@ template <typename T, typename L>
 LG_HD_INLINE LaneMask<L> evaluate_splat(const SplatGeometry<T>& g, L px, L py, SplatSample<L>& s) {
     L rho;
     const LaneMask<L> in_reach = splat_hit(g, px, py, s, rho);
-    return splat_alpha(g.opacity, lane_select(in_reach, L(-0.5) * rho, L(kUnreachedExponent)), s);
+    return splat_alpha(g.opacity, splat_exponent(rho, in_reach), s);
 }
 
 // Gradient accumulators of one surfel over many pixels, in the kernel's own variables: the per-pixel work

@@ -153,9 +153,7 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
                 const auto reached = raster::splat_hit(st.entry_splat[e], cx, cy, r.smp, rho) &
                                      lanes_in(st.entry_footprint[e].rect, px, py) &
                                      (I(typename I::I(r.k + 1)) <= s.contributors);
-                // The exponent waits in the alpha field (kUnreachedExponent where the pair was not
-                // composited).
-                r.smp.alpha = lane_select(reached, P(-0.5) * rho, P(raster::kUnreachedExponent));
+                r.smp.alpha = raster::splat_exponent(rho, reached);  // the exponent waits in the alpha field
             }
             for (std::uint32_t j = chunk; j < chunk_end; ++j) {
                 Unblended& r = record(j);

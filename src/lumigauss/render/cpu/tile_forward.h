@@ -104,8 +104,7 @@ LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, RasterState<T>
                 P rho;
                 const auto reached = raster::splat_hit(st.entry_splat[e], cx, cy, hit, rho) &
                                      lanes_in(st.entry_footprint[e].rect, px, py);
-                store_pack(&chunk_alpha[(n - chunk) * kLanes],
-                           lane_select(reached, P(-0.5) * rho, P(raster::kUnreachedExponent)));
+                store_pack(&chunk_alpha[(n - chunk) * kLanes], raster::splat_exponent(rho, reached));
                 store_pack(&chunk_z[(n - chunk) * kLanes], hit.z);
             }
             for (std::size_t n = chunk; n < chunk_end; ++n) {
