@@ -10,6 +10,9 @@
 
 namespace lumigauss {
 
+// Colour channels per surfel every backend handles (RGB, shadowed + unshadowed RGB, and some room).
+inline constexpr int kMaxChannels = 16;
+
 // Activated surfel parameters for one render: linear scales, opacity in [0, 1], any number of colour
 // channels (3 for RGB; 6 when shadowed and unshadowed shading are rendered in one pass).
 template <typename T>
@@ -73,8 +76,12 @@ struct SplatFootprint {
 // Tiles a surfel's box touches (inclusive).
 struct TileSpan {
     int tx0, ty0, tx1, ty1;
-    std::uint32_t count() const { return std::uint32_t((tx1 - tx0 + 1) * (ty1 - ty0 + 1)); }
+    LG_HD std::uint32_t count() const { return std::uint32_t((tx1 - tx0 + 1) * (ty1 - ty0 + 1)); }
 };
+LG_HD inline TileSpan tile_span(const raster::PixelRect& r) {
+    return {r.x0 / raster::kTileSize, r.y0 / raster::kTileSize, r.x1 / raster::kTileSize,
+            r.y1 / raster::kTileSize};
+}
 
 // What binning needs of a visible surfel, compact.
 struct VisibleSurfel {

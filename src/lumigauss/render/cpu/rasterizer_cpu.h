@@ -10,9 +10,6 @@
 
 namespace lumigauss {
 
-// Colour channels per surfel the CPU backend handles (RGB, shadowed + unshadowed RGB, and some room).
-inline constexpr int kMaxChannels = 16;
-
 template <typename T>
 RasterImages<T> rasterize_forward_cpu(const Camera& camera, const SurfelBatch<T>& surfels,
                                       const RasterSettings<T>& settings, RasterState<T>& state);

@@ -13,12 +13,6 @@
 namespace lumigauss {
 namespace {
 
-using raster::kTileSize;
-
-TileSpan tile_span(const raster::PixelRect& r) {
-    return {r.x0 / kTileSize, r.y0 / kTileSize, r.x1 / kTileSize, r.y1 / kTileSize};
-}
-
 // Parallel passes run over fixed chunks of surfels, each with its own per-tile counters, so that the result
 // is the serial one. At most kMaxChunks chunks bound the counters at kMaxChunks x tiles.
 constexpr std::size_t kMinChunk = 16384, kMaxChunks = 32;
