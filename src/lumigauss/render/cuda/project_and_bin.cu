@@ -1,0 +1,244 @@
+// The CUDA backend's per-surfel passes: projection, binning into tiles, and the projection's backward.
+#include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_scan.cuh>
+
+#include <bit>
+
+#include "lumigauss/render/cuda/raster_state_cuda.cuh"
+
+namespace lumigauss::cuda {
+namespace {
+
+constexpr int kThreads = 256;
+
+unsigned blocks_for(std::size_t n) {
+    return unsigned((n + kThreads - 1) / kThreads);
+}
+
+template <typename T>
+__device__ Vec3<float> to_float(Vec3<T> v) {
+    return {float(v.x), float(v.y), float(v.z)};
+}
+
+// One thread per surfel: the CPU backend's projection (project_surfel in double; what it stores, rounded
+// to float), and the number of tiles its pixel box touches (0: not visible).
+__global__ void project_kernel(std::size_t n, const float* __restrict__ means,
+                               const float* __restrict__ quats, const float* __restrict__ scales,
+                               const float* __restrict__ opacities, raster::PinholeView<double> view,
+                               raster::ProjectionVjpInputs<float>* projections,
+                               raster::SplatGeometry<float>* splats, SplatFootprint<float>* footprints,
+                               std::uint32_t* tiles_touched) {
+    const std::size_t i = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= n) return;
+    const raster::SurfelGeometry<double> g{
+        {means[3 * i], means[3 * i + 1], means[3 * i + 2]},
+        {quats[4 * i], quats[4 * i + 1], quats[4 * i + 2], quats[4 * i + 3]},
+        scales[2 * i],
+        scales[2 * i + 1]};
+    const double opacity = opacities[i];
+    raster::ProjectedSurfel<double> p;
+    if (!raster::project_surfel(g, opacity, view, p)) {
+        tiles_touched[i] = 0;
+        return;
+    }
+    const auto sg = raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, opacity, p.reach);
+    projections[i] = {to_float(p.tu), to_float(p.tv), to_float(p.tw), {float(p.center.x), float(p.center.y)},
+                      float(p.flip),  p.conic_center};
+    splats[i] = {to_float(sg.pa),
+                 to_float(sg.pb),
+                 to_float(sg.pd),
+                 to_float(sg.tw),
+                 {float(sg.center.x), float(sg.center.y)},
+                 float(sg.opacity),
+                 float(sg.rho_cutoff)};
+    footprints[i] = {p.rect, to_float(p.normal), float(p.depth)};
+    tiles_touched[i] = tile_span(p.rect).count();
+}
+
+// One thread per visible surfel: its emissions, numbered from its offset tile by tile (row-major, as the
+// CPU backend numbers them), each keyed by tile and depth. The depth is positive, so its float bits order
+// like it.
+__global__ void emit_kernel(std::size_t n, int tiles_x, const SplatFootprint<float>* __restrict__ footprints,
+                            const std::uint32_t* __restrict__ tiles_touched,
+                            const std::uint32_t* __restrict__ offsets, std::uint64_t* keys,
+                            std::uint32_t* emissions, std::uint32_t* emission_surfel) {
+    const std::size_t i = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= n || tiles_touched[i] == 0) return;
+    const SplatFootprint<float> f = footprints[i];
+    const TileSpan span = tile_span(f.rect);
+    const std::uint64_t depth_bits = __float_as_uint(f.depth);
+    std::uint32_t e = offsets[i];
+    for (int ty = span.ty0; ty <= span.ty1; ++ty)
+        for (int tx = span.tx0; tx <= span.tx1; ++tx, ++e) {
+            keys[e] = (std::uint64_t(ty * tiles_x + tx) << 32) | depth_bits;
+            emissions[e] = e;
+            emission_surfel[e] = std::uint32_t(i);
+        }
+}
+
+// One thread per sorted entry: where each tile's run of entries starts (tiles with none start where the
+// next one does).
+__global__ void tile_ranges_kernel(std::size_t m, int num_tiles, const std::uint64_t* __restrict__ keys,
+                                   std::uint32_t* tile_start) {
+    const std::size_t k = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (k >= m) return;
+    const int tile = int(keys[k] >> 32);
+    const int previous = k == 0 ? -1 : int(keys[k - 1] >> 32);
+    for (int t = previous + 1; t <= tile; ++t) tile_start[t] = std::uint32_t(k);
+    if (k == m - 1)
+        for (int t = tile + 1; t <= num_tiles; ++t) tile_start[t] = std::uint32_t(m);
+}
+
+// One thread per surfel: the sum of its (surfel, tile) slots in emission order, then the CPU backend's
+// conversion to the surfel's gradients (to_ray_transform_grad, project_surfel_vjp_lanes, in float).
+template <int kValues>
+__global__ void reduce_kernel(std::size_t n, int channels, raster::PinholeView<float> view,
+                              const float* __restrict__ quats, const float* __restrict__ scales,
+                              const raster::ProjectionVjpInputs<float>* __restrict__ projections,
+                              const std::uint32_t* __restrict__ tiles_touched,
+                              const std::uint32_t* __restrict__ offsets, const float* __restrict__ slots,
+                              float* d_means, float* d_quats, float* d_scales, float* d_opacities,
+                              float* d_colors, float* d_mean2d) {
+    const std::size_t i = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= n) return;
+    using S = SlotValues;
+    const int values = S::count(channels);
+    float sum[kValues];
+#pragma unroll
+    for (int v = 0; v < kValues; ++v) sum[v] = 0.0f;
+    const bool visible = tiles_touched[i] != 0;
+    if (visible) {
+        for (std::uint32_t e = offsets[i]; e < offsets[i + 1]; ++e) {
+            const float* slot = &slots[std::size_t(e) * values];
+#pragma unroll
+            for (int v = 0; v < kValues; ++v)
+                if (v < values) sum[v] += slot[v];
+        }
+    }
+    if (!visible) {
+        for (int k = 0; k < 3; ++k) d_means[3 * i + k] = 0.0f;
+        for (int k = 0; k < 4; ++k) d_quats[4 * i + k] = 0.0f;
+        d_scales[2 * i] = d_scales[2 * i + 1] = 0.0f;
+        d_opacities[i] = 0.0f;
+        for (int c = 0; c < channels; ++c) d_colors[i * channels + c] = 0.0f;
+        d_mean2d[2 * i] = d_mean2d[2 * i + 1] = 0.0f;
+        return;
+    }
+    const auto vec3 = [&](int k) { return Vec3<float>{sum[k], sum[k + 1], sum[k + 2]}; };
+    raster::SplatGrad<float> sg;
+    sg.pa = vec3(S::kPa), sg.pb = vec3(S::kPb), sg.pd = vec3(S::kPd), sg.tw = vec3(S::kTw);
+    sg.center = {sum[S::kCenter], sum[S::kCenter + 1]};
+    sg.opacity = sum[S::kOpacity];
+    raster::ProjectedSurfelGrad<float> pg{};
+    pg.normal = vec3(S::kNormal);
+    const raster::ProjectionVjpInputs<float> ps = projections[i];
+    float g_opacity = 0.0f;
+    raster::to_ray_transform_grad(ps.tu, ps.tv, ps.tw, ps.center, sg, pg, g_opacity);
+    const raster::SurfelGeometry<float> geometry{
+        {0.0f, 0.0f, 0.0f},  // the mean: the backward does not read it
+        {quats[4 * i], quats[4 * i + 1], quats[4 * i + 2], quats[4 * i + 3]},
+        scales[2 * i],
+        scales[2 * i + 1]};
+    const auto gg = raster::project_surfel_vjp_lanes(geometry, view, ps, pg);
+    for (int k = 0; k < 3; ++k) d_means[3 * i + k] = gg.mean[k];
+    for (int k = 0; k < 4; ++k) d_quats[4 * i + k] = gg.quat[k];
+    d_scales[2 * i] = gg.scale_u;
+    d_scales[2 * i + 1] = gg.scale_v;
+    d_opacities[i] = g_opacity;
+    // Screen-space gradient for densification, as on the CPU (rasterizer_cpu.cpp).
+    d_mean2d[2 * i] = pg.tu.z * ps.tw.z;
+    d_mean2d[2 * i + 1] = pg.tv.z * ps.tw.z;
+#pragma unroll
+    for (int c = 0; c < kValues - S::kColor; ++c)  // compile-time indices keep `sum` in registers
+        if (c < channels) d_colors[i * channels + c] = sum[S::kColor + c];
+}
+
+int significant_bits(std::uint32_t x) {
+    return 32 - std::countl_zero(x);
+}
+
+}  // namespace
+
+void project_surfels(RasterStateCuda& st, cudaStream_t stream) {
+    const std::size_t n = st.surfels;
+    st.projections.resize(n);
+    st.splats.resize(n);
+    st.footprints.resize(n);
+    st.tiles_touched.resize(n);
+    if (n == 0) return;
+    project_kernel<<<blocks_for(n), kThreads, 0, stream>>>(
+        n, st.means.data(), st.quats.data(), st.scales.data(), st.opacities.data(), st.view,
+        st.projections.data(), st.splats.data(), st.footprints.data(), st.tiles_touched.data());
+    check_launch("project_kernel");
+}
+
+void bin_surfels(RasterStateCuda& st, cudaStream_t stream) {
+    const std::size_t n = st.surfels;
+    const int num_tiles = st.tiles_x * st.tiles_y;
+    st.emission_offset.resize(n + 1);
+    st.tile_start.resize(std::size_t(num_tiles) + 1);
+    st.emission_offset.clear(stream);
+    std::size_t scan_bytes = 0;
+    if (n > 0) {
+        check(cub::DeviceScan::InclusiveSum(nullptr, scan_bytes, st.tiles_touched.data(),
+                                            st.emission_offset.data() + 1, n, stream),
+              "scan size");
+        st.sort_scratch.resize(scan_bytes);
+        check(cub::DeviceScan::InclusiveSum(st.sort_scratch.data(), scan_bytes, st.tiles_touched.data(),
+                                            st.emission_offset.data() + 1, n, stream),
+              "scan");
+    }
+    std::uint32_t m = 0;
+    check(cudaMemcpyAsync(&m, st.emission_offset.data() + n, sizeof m, cudaMemcpyDeviceToHost, stream),
+          "entry count");
+    check(cudaStreamSynchronize(stream), "binning");
+    st.entries = m;
+    st.keys.resize(m), st.sorted_keys.resize(m);
+    st.emissions.resize(m), st.sorted_emissions.resize(m), st.emission_surfel.resize(m);
+    if (m == 0) {
+        st.tile_start.clear(stream);
+        return;
+    }
+    emit_kernel<<<blocks_for(n), kThreads, 0, stream>>>(
+        n, st.tiles_x, st.footprints.data(), st.tiles_touched.data(), st.emission_offset.data(),
+        st.keys.data(), st.emissions.data(), st.emission_surfel.data());
+    check_launch("emit_kernel");
+    const int end_bit = 32 + significant_bits(std::uint32_t(num_tiles));
+    std::size_t sort_bytes = 0;
+    check(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, st.keys.data(), st.sorted_keys.data(),
+                                          st.emissions.data(), st.sorted_emissions.data(), m, 0, end_bit,
+                                          stream),
+          "sort size");
+    st.sort_scratch.resize(sort_bytes);
+    check(cub::DeviceRadixSort::SortPairs(st.sort_scratch.data(), sort_bytes, st.keys.data(),
+                                          st.sorted_keys.data(), st.emissions.data(),
+                                          st.sorted_emissions.data(), m, 0, end_bit, stream),
+          "sort");
+    tile_ranges_kernel<<<blocks_for(m), kThreads, 0, stream>>>(m, num_tiles, st.sorted_keys.data(),
+                                                               st.tile_start.data());
+    check_launch("tile_ranges_kernel");
+}
+
+void reduce_surfel_gradients(RasterStateCuda& st, cudaStream_t stream) {
+    const std::size_t n = st.surfels;
+    const int c = st.channels;
+    st.d_means.resize(3 * n), st.d_quats.resize(4 * n), st.d_scales.resize(2 * n);
+    st.d_opacities.resize(n), st.d_colors.resize(n * c), st.d_mean2d.resize(2 * n);
+    if (n == 0) return;
+    const auto launch = [&](auto kernel) {
+        kernel<<<blocks_for(n), kThreads, 0, stream>>>(
+            n, c, st.view_f, st.quats.data(), st.scales.data(), st.projections.data(),
+            st.tiles_touched.data(), st.emission_offset.data(), st.slots.data(), st.d_means.data(),
+            st.d_quats.data(), st.d_scales.data(), st.d_opacities.data(), st.d_colors.data(),
+            st.d_mean2d.data());
+    };
+    if (c <= 3)
+        launch(reduce_kernel<SlotValues::count(3)>);
+    else if (c <= 6)
+        launch(reduce_kernel<SlotValues::count(6)>);
+    else
+        launch(reduce_kernel<SlotValues::count(kMaxChannels)>);
+    check_launch("reduce_kernel");
+}
+
+}  // namespace lumigauss::cuda
