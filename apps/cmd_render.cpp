@@ -15,6 +15,7 @@
 #include "lumigauss/io/image.h"
 #include "lumigauss/relight/relight_job.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/render/cuda/rasterizer_cuda.h"
 #include "lumigauss/render/raster_maps.h"
 #include "lumigauss/scene/splat_ply.h"
 #include "lumigauss/util/error.h"
@@ -26,6 +27,7 @@ struct RenderOptions {
     std::string ply, scene, out = "renders", split = "all";
     int downscale = 0;  // 0: 1 for --ply, the run's training resolution for a run
     int threads = 0;
+    std::string backend = "cpu";
     std::vector<float> background{0, 0, 0};
     bool background_given = false, split_given = false;
     bool extra_maps = false;
@@ -79,7 +81,10 @@ void run_render(const RenderOptions& o) {
     if (o.background.size() != 3) throw Error("--background needs three values R,G,B");
     if (o.run.empty() == o.ply.empty())
         throw Error("render: give either a training run folder (render RUN --light L) or --ply FILE");
-    if (!o.run.empty()) return run_relight(o);
+    if (!o.run.empty()) {
+        if (o.backend != "cpu") throw Error("--backend is for --ply; a run renders on the CPU");
+        return run_relight(o);
+    }
     if (o.scene.empty()) throw Error("render --ply needs --scene (the cameras to render from)");
     DatasetOptions dopt;
     dopt.downscale = o.downscale > 0 ? o.downscale : 1;
@@ -92,11 +97,19 @@ void run_render(const RenderOptions& o) {
     int done = 0;
     RasterState<float> state;  // reused: its buffers and the images' keep their memory from view to view
     RasterImages<float> img;
+    std::unique_ptr<CudaRasterizer> gpu;  // says why when this build or machine has no GPU backend
+    if (o.backend == "cuda") {
+        gpu = std::make_unique<CudaRasterizer>();
+        std::printf("render: on %s\n", cuda_backend_description().c_str());
+    }
     for (const View& v : scene.views) {
         if (o.split != "all" && o.split != split_name(v.split)) continue;
         const auto t0 = std::chrono::steady_clock::now();
         colors_for_view(model, v.camera.center());
-        rasterize_forward_cpu(v.camera, model.surfels, settings, state, img);
+        if (gpu)
+            gpu->forward(v.camera, model.surfels, settings, img);
+        else
+            rasterize_forward_cpu(v.camera, model.surfels, settings, state, img);
         const auto path = output_path(o.out, v.name, ".png");
         std::filesystem::create_directories(path.parent_path());
         write_png(path.string(), raster_channels(img, 0, 3));
@@ -104,7 +117,7 @@ void run_render(const RenderOptions& o) {
         const double ms =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         std::printf("  [%d] %s  %dx%d  %zu intersections  %.1f ms\n", ++done, path.string().c_str(),
-                    v.camera.width, v.camera.height, state.intersections(), ms);
+                    v.camera.width, v.camera.height, gpu ? gpu->intersections() : state.intersections(), ms);
     }
     if (done == 0) throw Error("no view of " + o.scene + " is in split '" + o.split + "'");
     std::printf("render: wrote %d images to %s\n", done, o.out.c_str());
@@ -139,6 +152,11 @@ void register_render(CLI::App& app) {
                     "alpha; default black)")
         ->delimiter(',');
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)");
+    cmd->add_option("--backend", o->backend,
+                    "--ply: rasterize on the CPU or on the GPU (cuda: builds with the CUDA backend, on a "
+                    "machine with a GPU)")
+        ->check(CLI::IsMember({"cpu", "cuda"}))
+        ->capture_default_str();
     cmd->add_flag("--maps", o->extra_maps,
                   "--ply: also write alpha (PNG), expected depth (EXR) and world normals (PNG)");
 

@@ -6,6 +6,7 @@
 #include "io_test_util.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/render/cuda/rasterizer_cuda.h"
 #include "lumigauss/scene/splat_ply.h"
 
 namespace lumigauss {
@@ -71,6 +72,27 @@ TEST(CliRender, BadModelGivesAnErrorNamingTheFile) {
     EXPECT_NE(rc, 0);
     const std::string log = test::read_text(dir / "log.txt");
     EXPECT_NE(log.find("bad.ply"), std::string::npos) << log;
+}
+
+// Without the CUDA backend (CI) `--backend cuda` is refused with the reason, and nothing is written; with it,
+// the GPU's images are the CPU's (bench/cuda_device_check.sh compares the two backends' PNGs on a GPU).
+TEST(CliRender, CudaBackendWithoutGpuSaysWhy) {
+    if (cuda_backend_available()) GTEST_SKIP() << "a GPU is usable here";
+    TempDir dir;
+    test::write_scene(dir.path() / "scene", test::small_model(1, 16, 16));
+    ViewDependentSurfels m;
+    m.sh_degree = 0;
+    m.surfels.resize(1);
+    m.sh.assign(3, 0.f);
+    m.surfels.quats[0] = 1.f, m.surfels.scales[0] = m.surfels.scales[1] = 0.2f, m.surfels.opacities[0] = 0.8f;
+    save_2dgs_ply(dir / "model.ply", m);
+    const std::string cmd = std::string(LUMIGAUSS_BINARY) + " render --ply " + (dir / "model.ply") +
+                            " --scene " + (dir / "scene") + " -o " + (dir / "out") + " --backend cuda > " +
+                            (dir / "log.txt") + " 2>&1";
+    EXPECT_NE(std::system(cmd.c_str()), 0);
+    const std::string log = test::read_text(dir / "log.txt");
+    EXPECT_NE(log.find("CUDA"), std::string::npos) << log;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out"));
 }
 
 }  // namespace
