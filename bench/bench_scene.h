@@ -3,7 +3,9 @@
 // ground in front of it (oriented in the surface, sized so that neighbours overlap as after training), seen
 // by a camera framing the building.
 #include <cmath>
+#include <map>
 #include <random>
+#include <tuple>
 
 #include "lumigauss/io/camera.h"
 #include "lumigauss/math/quaternion.h"
@@ -71,6 +73,18 @@ inline SurfelBatch<float> bench_surfels(std::size_t count, std::uint32_t seed = 
     }
     s.resize(i);
     return s;
+}
+
+// A benchmark's camera and surfels, made once per size for every benchmark of the program.
+struct BenchFixture {
+    Camera cam;
+    SurfelBatch<float> surfels;
+};
+inline const BenchFixture& bench_fixture(int width, int height, int count) {
+    static std::map<std::tuple<int, int, int>, BenchFixture> cache;
+    auto& f = cache[{width, height, count}];
+    if (f.surfels.size() == 0) f = {bench_camera(width, height), bench_surfels(std::size_t(count))};
+    return f;
 }
 
 }  // namespace lumigauss::bench

@@ -40,18 +40,6 @@ WorkCounts work_counts(const RasterState<T>& st) {
     return w;
 }
 
-struct Fixture {
-    Camera cam;
-    SurfelBatch<float> surfels;
-};
-
-const Fixture& fixture(int width, int height, int count) {
-    static std::map<std::tuple<int, int, int>, Fixture> cache;
-    auto& f = cache[{width, height, count}];
-    if (f.surfels.size() == 0) f = {bench_camera(width, height), bench_surfels(std::size_t(count))};
-    return f;
-}
-
 void set_counters(benchmark::State& state, const RasterState<float>& st, const RasterImages<float>& img) {
     const WorkCounts w = work_counts(st);
     const double pairs = w.pairs;
@@ -92,7 +80,7 @@ struct PhaseSums {
 // 1.5 s against 0.39 s for the next; the mean over the one or two iterations a short run makes included
 // it. (At 200k the buffers come back from malloc's heap already mapped, and it did not show.)
 void BM_Forward(benchmark::State& state) {
-    const auto& f = fixture(int(state.range(0)), int(state.range(1)), int(state.range(2)));
+    const auto& f = bench_fixture(int(state.range(0)), int(state.range(1)), int(state.range(2)));
     tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(3)));
     RasterState<float> st;
     RasterImages<float> img;
@@ -108,7 +96,7 @@ void BM_Forward(benchmark::State& state) {
 }
 
 void BM_Backward(benchmark::State& state) {
-    const auto& f = fixture(int(state.range(0)), int(state.range(1)), int(state.range(2)));
+    const auto& f = bench_fixture(int(state.range(0)), int(state.range(1)), int(state.range(2)));
     tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(3)));
     RasterState<float> st;
     const RasterImages<float> img = rasterize_forward_cpu(f.cam, f.surfels, RasterSettings<float>{}, st);
@@ -130,7 +118,7 @@ void BM_Backward(benchmark::State& state) {
 }
 
 void BM_ForwardBackward(benchmark::State& state) {
-    const auto& f = fixture(int(state.range(0)), int(state.range(1)), int(state.range(2)));
+    const auto& f = bench_fixture(int(state.range(0)), int(state.range(1)), int(state.range(2)));
     tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(3)));
     RasterState<float> st;
     RasterImages<float> img;

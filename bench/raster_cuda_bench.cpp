@@ -5,26 +5,12 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
-#include <map>
-#include <tuple>
 
 #include "bench_scene.h"
 #include "lumigauss/render/cuda/rasterizer_cuda.h"
 
 namespace lumigauss::bench {
 namespace {
-
-struct Fixture {
-    Camera cam;
-    SurfelBatch<float> surfels;
-};
-
-const Fixture& fixture(int width, int height, int count) {
-    static std::map<std::tuple<int, int, int>, Fixture> cache;
-    auto& f = cache[{width, height, count}];
-    if (f.surfels.size() == 0) f = {bench_camera(width, height), bench_surfels(std::size_t(count))};
-    return f;
-}
 
 CudaRasterizer& rasterizer() {
     static CudaRasterizer r;
@@ -53,7 +39,7 @@ struct PhaseSums {
 
 // mode 0: forward, 1: backward, 2: both.
 void run(benchmark::State& state, int mode) {
-    const auto& f = fixture(int(state.range(0)), int(state.range(1)), int(state.range(2)));
+    const auto& f = bench_fixture(int(state.range(0)), int(state.range(1)), int(state.range(2)));
     CudaRasterizer& gpu = rasterizer();
     RasterImages<float> img;
     RasterImageGrads<float> g;
