@@ -89,6 +89,15 @@ __global__ void tile_ranges_kernel(std::size_t m, int num_tiles, const std::uint
         for (int t = tile + 1; t <= num_tiles; ++t) tile_start[t] = std::uint32_t(m);
 }
 
+// One thread per tile: its list's length and its id (the keys and values of the longest-first sort).
+__global__ void tile_lengths_kernel(int num_tiles, const std::uint32_t* __restrict__ tile_start,
+                                    std::uint32_t* lengths, std::uint32_t* ids) {
+    const int t = int(blockIdx.x * blockDim.x + threadIdx.x);
+    if (t >= num_tiles) return;
+    lengths[t] = tile_start[t + 1] - tile_start[t];
+    ids[t] = std::uint32_t(t);
+}
+
 // One thread per surfel: the sum of its (surfel, tile) slots in emission order, then the CPU backend's
 // conversion to the surfel's gradients (to_ray_transform_grad, project_surfel_vjp_lanes, in float).
 template <int kValues>
@@ -157,6 +166,26 @@ int significant_bits(std::uint32_t x) {
     return 32 - std::countl_zero(x);
 }
 
+// st.tile_order: the tiles by decreasing list length (ties by tile id: a stable sort).
+void order_tiles(RasterStateCuda& st, cudaStream_t stream) {
+    const int num_tiles = st.tiles_x * st.tiles_y;
+    st.tile_lengths.resize(num_tiles), st.sorted_lengths.resize(num_tiles);
+    st.tile_ids.resize(num_tiles), st.tile_order.resize(num_tiles);
+    tile_lengths_kernel<<<blocks_for(std::size_t(num_tiles)), kThreads, 0, stream>>>(
+        num_tiles, st.tile_start.data(), st.tile_lengths.data(), st.tile_ids.data());
+    check_launch("tile_lengths_kernel");
+    std::size_t bytes = 0;
+    check(cub::DeviceRadixSort::SortPairsDescending(nullptr, bytes, st.tile_lengths.data(),
+                                                    st.sorted_lengths.data(), st.tile_ids.data(),
+                                                    st.tile_order.data(), num_tiles, 0, 32, stream),
+          "tile order size");
+    st.sort_scratch.resize(bytes);
+    check(cub::DeviceRadixSort::SortPairsDescending(st.sort_scratch.data(), bytes, st.tile_lengths.data(),
+                                                    st.sorted_lengths.data(), st.tile_ids.data(),
+                                                    st.tile_order.data(), num_tiles, 0, 32, stream),
+          "tile order");
+}
+
 }  // namespace
 
 void project_surfels(RasterStateCuda& st, cudaStream_t stream) {
@@ -197,6 +226,7 @@ void bin_surfels(RasterStateCuda& st, cudaStream_t stream) {
     st.emissions.resize(m), st.sorted_emissions.resize(m), st.emission_surfel.resize(m);
     if (m == 0) {
         st.tile_start.clear(stream);
+        order_tiles(st, stream);
         return;
     }
     emit_kernel<<<blocks_for(n), kThreads, 0, stream>>>(
@@ -217,6 +247,7 @@ void bin_surfels(RasterStateCuda& st, cudaStream_t stream) {
     tile_ranges_kernel<<<blocks_for(m), kThreads, 0, stream>>>(m, num_tiles, st.sorted_keys.data(),
                                                                st.tile_start.data());
     check_launch("tile_ranges_kernel");
+    order_tiles(st, stream);
 }
 
 void reduce_surfel_gradients(RasterStateCuda& st, cudaStream_t stream) {
@@ -225,19 +256,13 @@ void reduce_surfel_gradients(RasterStateCuda& st, cudaStream_t stream) {
     st.d_means.resize(3 * n), st.d_quats.resize(4 * n), st.d_scales.resize(2 * n);
     st.d_opacities.resize(n), st.d_colors.resize(n * c), st.d_mean2d.resize(2 * n);
     if (n == 0) return;
-    const auto launch = [&](auto kernel) {
-        kernel<<<blocks_for(n), kThreads, 0, stream>>>(
+    with_channel_capacity(c, [&](auto capacity) {
+        reduce_kernel<SlotValues::count(decltype(capacity)::value)><<<blocks_for(n), kThreads, 0, stream>>>(
             n, c, st.view_f, st.quats.data(), st.scales.data(), st.projections.data(),
             st.tiles_touched.data(), st.emission_offset.data(), st.slots.data(), st.d_means.data(),
             st.d_quats.data(), st.d_scales.data(), st.d_opacities.data(), st.d_colors.data(),
             st.d_mean2d.data());
-    };
-    if (c <= 3)
-        launch(reduce_kernel<SlotValues::count(3)>);
-    else if (c <= 6)
-        launch(reduce_kernel<SlotValues::count(6)>);
-    else
-        launch(reduce_kernel<SlotValues::count(kMaxChannels)>);
+    });
     check_launch("reduce_kernel");
 }
 

@@ -2,6 +2,7 @@
 // What the CUDA backend keeps on the device between a forward and its backward, and the launchers of its
 // kernels (internal to render/cuda).
 #include <cstdint>
+#include <type_traits>
 
 #include "lumigauss/render/cuda/device_buffer.cuh"
 #include "lumigauss/render/cuda/rasterizer_cuda.h"
@@ -30,6 +31,9 @@ struct RasterStateCuda {
     DeviceBuffer<std::uint32_t> emissions, sorted_emissions, emission_surfel;
     DeviceBuffer<unsigned char> sort_scratch;
     DeviceBuffer<std::uint32_t> tile_start;  // per tile: first sorted entry; size tiles + 1
+    // The tiles, longest list first: the order in which the tile kernels' blocks take them, so that the
+    // longest lists start first instead of leaving a tail behind the others.
+    DeviceBuffer<std::uint32_t> tile_lengths, sorted_lengths, tile_ids, tile_order;
 
     // Maps and what the backward needs per pixel.
     DeviceBuffer<float> color, alpha, depth, median_depth, normal, distortion;
@@ -49,6 +53,18 @@ struct SlotValues {
                          kColor = 18;
     static constexpr int count(int channels) { return kColor + channels; }
 };
+
+// The kernels are compiled for 3, 6 and kMaxChannels colour channels (register arrays need a compile-time
+// size): calls f(std::integral_constant<int, C>{}) with the smallest of those that holds `channels`.
+template <typename F>
+void with_channel_capacity(int channels, F&& f) {
+    if (channels <= 3)
+        f(std::integral_constant<int, 3>{});
+    else if (channels <= 6)
+        f(std::integral_constant<int, 6>{});
+    else
+        f(std::integral_constant<int, kMaxChannels>{});
+}
 
 // project_and_bin.cu
 void project_surfels(RasterStateCuda& st, cudaStream_t stream);

@@ -4,8 +4,9 @@
 //
 // forward:  one thread per surfel projects it (in double, as the CPU does) and counts its tiles; a prefix
 //           sum numbers the (surfel, tile) emissions, a stable radix sort on (tile, depth) orders them
-//           front to back within each tile; one block of 16x16 threads per tile then blends its pixels,
-//           one thread per pixel, the surfels staged through shared memory in batches.
+//           front to back within each tile; one block of 16x16 threads per tile (longest lists first)
+//           then blends its pixels, one thread per pixel, the surfels staged through shared memory in
+//           batches.
 // backward: per tile the same walk back to front; each entry's per-pixel gradients are summed over the
 //           block (warp shuffles, then the warps in a fixed order) into its (surfel, tile) slot, and a
 //           thread per surfel sums its slots and runs the projection's backward. No atomics: the result

@@ -48,6 +48,7 @@ struct StagedEntries {
 
 struct TileArgs {
     int width, height, tiles_x, channels;
+    const std::uint32_t* tile_order;  // block b renders tile tile_order[b]
     const std::uint32_t* tile_start;
     const std::uint32_t* sorted_emissions;
     const std::uint32_t* emission_surfel;
@@ -57,14 +58,14 @@ struct TileArgs {
 };
 
 struct Pixel {
-    int x, y;
+    int tile, x, y;
     bool inside;
 };
 __device__ Pixel tile_pixel(const TileArgs& a) {
-    const int tile = int(blockIdx.x);
+    const int tile = int(a.tile_order[blockIdx.x]);
     const int x = (tile % a.tiles_x) * raster::kTileSize + int(threadIdx.x) % raster::kTileSize;
     const int y = (tile / a.tiles_x) * raster::kTileSize + int(threadIdx.x) / raster::kTileSize;
-    return {x, y, x < a.width && y < a.height};
+    return {tile, x, y, x < a.width && y < a.height};
 }
 
 struct ForwardOutputs {
@@ -86,7 +87,7 @@ __global__ void __launch_bounds__(kTileThreads) forward_kernel(TileArgs a, Forwa
     s.live = p.inside;
     s.trans = 1.0f;
     s.median_entry = -1;
-    const std::uint32_t begin = a.tile_start[blockIdx.x], end = a.tile_start[blockIdx.x + 1];
+    const std::uint32_t begin = a.tile_start[p.tile], end = a.tile_start[p.tile + 1];
     for (std::uint32_t batch = begin; batch < end; batch += kForwardBatch) {
         // Also the barrier before the batch is overwritten.
         if (__syncthreads_count(s.live) == 0) break;
@@ -227,7 +228,7 @@ __global__ void __launch_bounds__(kTileThreads) backward_kernel(TileArgs a, Back
     __syncthreads();
     atomicMax(&most_contributors, std::uint32_t(s.contributors));
     __syncthreads();
-    const std::uint32_t begin = a.tile_start[blockIdx.x];
+    const std::uint32_t begin = a.tile_start[p.tile];
     const int values = S::count(a.channels);
     // Back to front over the entries up to the last any pixel composited.
     for (std::uint32_t batch_end = begin + most_contributors; batch_end > begin;) {
@@ -294,6 +295,7 @@ TileArgs tile_args(const RasterStateCuda& st) {
             st.height,
             st.tiles_x,
             st.channels,
+            st.tile_order.data(),
             st.tile_start.data(),
             st.sorted_emissions.data(),
             st.emission_surfel.data(),
@@ -330,12 +332,9 @@ void blend_tiles(RasterStateCuda& st, cudaStream_t stream) {
     out.distortion = st.distortion.data();
     out.final_transmittance = st.final_transmittance.data(), out.m1 = st.m1.data(), out.m2 = st.m2.data();
     out.contributors = st.contributors.data(), out.median_entry = st.median_entry.data();
-    if (st.channels <= 3)
-        launch_tiles(st, forward_kernel<3>, out, stream, "forward_kernel");
-    else if (st.channels <= 6)
-        launch_tiles(st, forward_kernel<6>, out, stream, "forward_kernel");
-    else
-        launch_tiles(st, forward_kernel<kMaxChannels>, out, stream, "forward_kernel");
+    with_channel_capacity(st.channels, [&](auto c) {
+        launch_tiles(st, forward_kernel<decltype(c)::value>, out, stream, "forward_kernel");
+    });
 }
 
 void backward_tiles(RasterStateCuda& st, cudaStream_t stream) {
@@ -350,12 +349,9 @@ void backward_tiles(RasterStateCuda& st, cudaStream_t stream) {
     in.g_median_depth = or_null(st.g_median_depth), in.g_normal = or_null(st.g_normal);
     in.g_distortion = or_null(st.g_distortion);
     in.slots = st.slots.data();
-    if (st.channels <= 3)
-        launch_tiles(st, backward_kernel<3>, in, stream, "backward_kernel");
-    else if (st.channels <= 6)
-        launch_tiles(st, backward_kernel<6>, in, stream, "backward_kernel");
-    else
-        launch_tiles(st, backward_kernel<kMaxChannels>, in, stream, "backward_kernel");
+    with_channel_capacity(st.channels, [&](auto c) {
+        launch_tiles(st, backward_kernel<decltype(c)::value>, in, stream, "backward_kernel");
+    });
 }
 
 }  // namespace lumigauss::cuda
