@@ -5,6 +5,10 @@ set_property(CACHE LUMIGAUSS_CUDA PROPERTY STRINGS ON OFF AUTO)
 set(LUMIGAUSS_WITH_CUDA OFF)
 if(LUMIGAUSS_CUDA STREQUAL "ON")
   set(LUMIGAUSS_WITH_CUDA ON)
+elseif(LUMIGAUSS_CUDA STREQUAL "AUTO" AND LUMIGAUSS_SANITIZE)
+  # The sanitizer build checks the CPU code (compute-sanitizer checks the GPU's: bench/cuda_device_check.sh);
+  # ASan's default shadow-memory layout also keeps the CUDA driver from starting.
+  message(STATUS "lumigauss: no CUDA backend in the sanitizer build")
 elseif(LUMIGAUSS_CUDA STREQUAL "AUTO")
   include(CheckLanguage)
   check_language(CUDA)
