@@ -257,8 +257,11 @@ TEST(CudaRasterizer, BadInputIsAnError) {
     o.channels = kMaxChannels + 1;
     RasterImages<float> img;
     EXPECT_THROW(gpu.forward(cam, random_surfels<float>(cam, 1, o), RasterSettings<float>{}, img), Error);
-    const SurfelBatch<float> s = random_surfels<float>(cam, 1);
+    SurfelBatch<float> s = random_surfels<float>(cam, 1);
     EXPECT_THROW(gpu.forward(cam, s, background(4), img), Error);  // 4 background values, 3 channels
+    s.scales.pop_back();
+    EXPECT_THROW(gpu.forward(cam, s, RasterSettings<float>{}, img), Error);  // arrays of the wrong size
+    s = random_surfels<float>(cam, 1);
     gpu.forward(cam, s, RasterSettings<float>{}, img);
     RasterImageGrads<float> g;
     g.alpha.assign(5, 1.0f);

@@ -109,6 +109,30 @@ TEST(RasterForward, SixChannelsRenderLikeTwoThreeChannelPasses) {
         }
 }
 
+TEST(RasterForward, InconsistentBatchIsAnErrorNamingTheArray) {
+    const Camera cam = test_camera();
+    SurfelBatch<float> s = convert_batch<float>(random_surfels<double>(cam, 4));
+    RasterState<float> st;
+    RasterImages<float> img;
+    s.colors.pop_back();
+    try {
+        rasterize_forward_cpu(cam, s, RasterSettings<float>{}, st, img);
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("colors"), std::string::npos) << e.what();
+    }
+    s = convert_batch<float>(random_surfels<double>(cam, 4));
+    rasterize_forward_cpu(cam, s, RasterSettings<float>{}, st, img);
+    s.quats.resize(3);
+    RasterImageGrads<float> g;
+    SurfelGrads<float> grads;
+    EXPECT_THROW(rasterize_backward_cpu(s, st, g, grads), Error);
+    RandomSceneOptions five;
+    five.count = 5;
+    s = convert_batch<float>(random_surfels<double>(cam, 4, five));
+    EXPECT_THROW(rasterize_backward_cpu(s, st, g, grads), Error);  // not the forward's surfels
+}
+
 TEST(RasterForward, EmptySceneIsBackground) {
     const Camera cam = test_camera();
     SurfelBatch<float> s;

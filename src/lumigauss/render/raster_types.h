@@ -2,11 +2,13 @@
 // Inputs and outputs of the surfel rasterizer (any backend), as structures of arrays.
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "lumigauss/io/camera.h"
 #include "lumigauss/render/cpu/radix_sort.h"
 #include "lumigauss/render/surfel_kernel.h"
+#include "lumigauss/util/error.h"
 
 namespace lumigauss {
 
@@ -36,6 +38,23 @@ struct SurfelBatch {
                 scales[2 * i + 1]};
     }
 };
+
+// Throws Error when a batch's arrays disagree with its surfel count and channels (a batch assembled by
+// hand): every backend checks before it reads them.
+template <typename T>
+void check_surfel_batch(const SurfelBatch<T>& s) {
+    const std::size_t n = s.size();
+    const auto expect = [&](const std::vector<T>& v, std::size_t per_surfel, const char* what) {
+        if (v.size() != per_surfel * n)
+            throw Error(std::string("surfel batch: ") + what + " has " + std::to_string(v.size()) +
+                        " values for " + std::to_string(n) + " surfels (" + std::to_string(per_surfel) +
+                        " each)");
+    };
+    expect(s.means, 3, "means");
+    expect(s.quats, 4, "quats");
+    expect(s.scales, 2, "scales");
+    expect(s.colors, std::size_t(s.channels), "colors");
+}
 
 // Every map the rasterizer writes, row-major, `width * height` pixels.
 template <typename T>

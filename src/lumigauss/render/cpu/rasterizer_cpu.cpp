@@ -367,6 +367,7 @@ void rasterize_forward_cpu(const Camera& camera, const SurfelBatch<T>& surfels,
     st.tiles_y = (camera.height + cpu::kTileSize - 1) / cpu::kTileSize;
     st.background = settings.background;
     check_channels(surfels.channels);
+    check_surfel_batch(surfels);
     auto clock = std::chrono::steady_clock::now();
     project_all(surfels, st);
     st.phase_ms.project = lap_ms(clock);
@@ -399,6 +400,10 @@ template <typename T>
 void backward_into(const SurfelBatch<T>& surfels, const RasterState<T>& st, const RasterImageGrads<T>& grads,
                    std::vector<T>& slot_buffer, SurfelGrads<T>& out) {
     check_channels(surfels.channels);
+    check_surfel_batch(surfels);
+    if (surfels.size() != st.visible.size())
+        throw Error("rasterizer backward: " + std::to_string(surfels.size()) + " surfels, the forward had " +
+                    std::to_string(st.visible.size()));
     auto clock = std::chrono::steady_clock::now();
     const std::size_t n = surfels.size();
     const int stride = cpu::SlotLayout::stride(surfels.channels);

@@ -86,6 +86,7 @@ void CudaRasterizer::forward(const Camera& camera, const SurfelBatch<float>& sur
     if (channels < 1 || channels > kMaxChannels)
         throw Error("the CUDA rasterizer supports 1 to " + std::to_string(kMaxChannels) +
                     " colour channels, not " + std::to_string(channels));
+    check_surfel_batch(surfels);
     if (!settings.background.empty() && int(settings.background.size()) != channels)
         throw Error("CUDA rasterizer: the background has " + std::to_string(settings.background.size()) +
                     " values for " + std::to_string(channels) + " channels");
