@@ -39,10 +39,13 @@ struct SurfelBatch {
     }
 };
 
-// Throws Error when a batch's arrays disagree with its surfel count and channels (a batch assembled by
-// hand): every backend checks before it reads them.
+// Throws Error when a batch has a channel count no backend handles or arrays that disagree with its
+// surfel count and channels (a batch assembled by hand): every backend checks before it reads them.
 template <typename T>
 void check_surfel_batch(const SurfelBatch<T>& s) {
+    if (s.channels < 1 || s.channels > kMaxChannels)
+        throw Error("the rasterizer supports 1 to " + std::to_string(kMaxChannels) +
+                    " colour channels, not " + std::to_string(s.channels));
     const std::size_t n = s.size();
     const auto expect = [&](const std::vector<T>& v, std::size_t per_surfel, const char* what) {
         if (v.size() != per_surfel * n)

@@ -25,6 +25,19 @@ struct PinholeView {
     int width, height;
 };
 
+// The same view in another scalar type (both backends project in double from the float view).
+template <typename To, typename From>
+LG_HD inline PinholeView<To> cast_view(const PinholeView<From>& v) {
+    return {v.rotation.template cast<To>(),
+            v.translation.template cast<To>(),
+            To(v.fx),
+            To(v.fy),
+            To(v.cx),
+            To(v.cy),
+            v.width,
+            v.height};
+}
+
 // Pixels a surfel may touch, clipped to the image (inclusive bounds).
 struct PixelRect {
     int x0 = 0, y0 = 0, x1 = -1, y1 = -1;

@@ -149,14 +149,7 @@ void project_all(const SurfelBatch<T>& surfels, RasterState<T>& st) {
     st.visible.assign(n, 0);
     resize_for_overwrite(st.splats, n);
     resize_for_overwrite(st.footprints, n);
-    const raster::PinholeView<double> view{st.view.rotation.template cast<double>(),
-                                           st.view.translation.template cast<double>(),
-                                           double(st.view.fx),
-                                           double(st.view.fy),
-                                           double(st.view.cx),
-                                           double(st.view.cy),
-                                           st.view.width,
-                                           st.view.height};
+    const raster::PinholeView<double> view = raster::cast_view<double>(st.view);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
                       [&](const auto& r) { project_surfels(surfels, st, view, r.begin(), r.end()); });
 }
@@ -210,12 +203,6 @@ double lap_ms(std::chrono::steady_clock::time_point& start) {
     return ms;
 }
 
-void check_channels(int channels) {
-    if (channels < 1 || channels > kMaxChannels)
-        throw Error("the rasterizer supports 1 to " + std::to_string(kMaxChannels) +
-                    " colour channels, not " + std::to_string(channels));
-}
-
 template <typename T>
 LG_ALWAYS_INLINE void write_zero_gradients(SurfelGrads<T>& out, std::size_t i, int channels) {
     std::fill_n(&out.means[3 * i], 3, T(0));
@@ -264,39 +251,23 @@ LG_ALWAYS_INLINE void reduce_lanes(const SurfelBatch<T>& surfels, const RasterSt
     }
     const auto sum_of = [&](int k) LG_LAMBDA_INLINE { return cpu::load_pack(sums[k]); };
     const auto input = [&](int k) LG_LAMBDA_INLINE { return cpu::load_pack(in[k]); };
-    const auto vec3 = [](auto get, int k) LG_LAMBDA_INLINE {
-        return Vec3<P>{get(k), get(k + 1), get(k + 2)};
-    };
-    raster::SplatGrad<P> sg;
-    sg.pa = vec3(sum_of, Slot::kPa), sg.pb = vec3(sum_of, Slot::kPb), sg.pd = vec3(sum_of, Slot::kPd);
-    sg.tw = vec3(sum_of, Slot::kTw);
-    sg.center = {sum_of(Slot::kCenter), sum_of(Slot::kCenter + 1)};
-    sg.opacity = sum_of(Slot::kOpacity);
-    raster::ProjectedSurfelGrad<P> pg{};
-    pg.normal = vec3(sum_of, Slot::kNormal);
-    const raster::ProjectionVjpInputs<P> ps{vec3(input, kTu), vec3(input, kTv),
-                                            vec3(input, kTw), {input(kCentre), input(kCentre + 1)},
-                                            input(kFlip),     cpu::load_lanes<T>(conic)};
-    P g_opacity(T(0));
-    raster::to_ray_transform_grad(ps.tu, ps.tv, ps.tw, ps.center, sg, pg, g_opacity);
-    const raster::SurfelGeometry<P> geometry{
-        {P(T(0)), P(T(0)), P(T(0))},  // the mean: the backward does not read it
-        {input(kQuat), input(kQuat + 1), input(kQuat + 2), input(kQuat + 3)},
-        input(kScale),
-        input(kScale + 1)};
-    const auto gg = raster::project_surfel_vjp_lanes(geometry, st.view, ps, pg);
-    // Screen-space gradient for densification: a translation by delta pixels adds delta * tw.z to the
-    // third column of rows tu and tv. Like the reference, it leaves out the low-pass branch.
-    const P mean2d_x = pg.tu.z * ps.tw.z, mean2d_y = pg.tv.z * ps.tw.z;
+    const auto vec3 = [&](int k) LG_LAMBDA_INLINE { return Vec3<P>{input(k), input(k + 1), input(k + 2)}; };
+    const raster::ProjectionVjpInputs<P> ps{vec3(kTu),    vec3(kTv),
+                                            vec3(kTw),    {input(kCentre), input(kCentre + 1)},
+                                            input(kFlip), cpu::load_lanes<T>(conic)};
+    const raster::SurfelSlotGrad<P> g = raster::surfel_grad_from_slots(
+        sum_of, ps, {input(kQuat), input(kQuat + 1), input(kQuat + 2), input(kQuat + 3)}, input(kScale),
+        input(kScale + 1), st.view);
+    const raster::SurfelGeometryGrad<P>& gg = g.geometry;
     for (int l = 0; l < count; ++l) {
         const std::size_t i = ids[l];
         for (int k = 0; k < 3; ++k) out.means[3 * i + k] = gg.mean[k][l];
         for (int k = 0; k < 4; ++k) out.quats[4 * i + k] = gg.quat[k][l];
         out.scales[2 * i] = gg.scale_u[l];
         out.scales[2 * i + 1] = gg.scale_v[l];
-        out.opacities[i] = g_opacity[l];
-        out.mean2d[2 * i] = mean2d_x[l];
-        out.mean2d[2 * i + 1] = mean2d_y[l];
+        out.opacities[i] = g.opacity[l];
+        out.mean2d[2 * i] = g.mean2d.x[l];
+        out.mean2d[2 * i + 1] = g.mean2d.y[l];
         for (int c = 0; c < C; ++c) out.colors[i * C + c] = sums[Slot::kColor + c][l];
     }
 }
@@ -366,7 +337,6 @@ void rasterize_forward_cpu(const Camera& camera, const SurfelBatch<T>& surfels,
     st.tiles_x = (camera.width + cpu::kTileSize - 1) / cpu::kTileSize;
     st.tiles_y = (camera.height + cpu::kTileSize - 1) / cpu::kTileSize;
     st.background = settings.background;
-    check_channels(surfels.channels);
     check_surfel_batch(surfels);
     auto clock = std::chrono::steady_clock::now();
     project_all(surfels, st);
@@ -399,7 +369,6 @@ namespace {
 template <typename T>
 void backward_into(const SurfelBatch<T>& surfels, const RasterState<T>& st, const RasterImageGrads<T>& grads,
                    std::vector<T>& slot_buffer, SurfelGrads<T>& out) {
-    check_channels(surfels.channels);
     check_surfel_batch(surfels);
     if (surfels.size() != st.visible.size())
         throw Error("rasterizer backward: " + std::to_string(surfels.size()) + " surfels, the forward had " +

@@ -12,14 +12,12 @@
 
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/render/cpu/tile_forward.h"
+#include "lumigauss/render/gradient_slot.h"
 
 namespace lumigauss::cpu {
 
-// Layout of one (surfel, tile) gradient slot, in the kernel's variables (surfel_kernel.h).
-struct SlotLayout {
-    static constexpr int kPa = 0, kPb = 3, kPd = 6, kTw = 9, kCenter = 12, kNormal = 14, kOpacity = 17,
-                         kColor = 18;
-    static constexpr int values(int channels) { return kColor + channels; }
+// Layout of one (surfel, tile) gradient slot (gradient_slot.h), padded to whole packs.
+struct SlotLayout : raster::GradSlot {
     // Slots are whole packs (the padding holds zeros), so that they are summed and copied as packs.
     static constexpr int stride(int channels) { return (values(channels) + kLanes - 1) / kLanes * kLanes; }
 };
@@ -177,17 +175,7 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
                     raster::splat_grad_terms(st.entry_splat[begin + r.k], cx, cy, r.smp, r.smp.screen_branch,
                                              r.grad.g_alpha, r.grad.g_z);
                 P q[kPadded];  // every entry assigned below (a `= {}` here costs a memset per iteration)
-                for (int m = 0; m < 3; ++m) {
-                    q[SlotLayout::kPa + m] = t.dx * t.g_p[m];
-                    q[SlotLayout::kPb + m] = t.dy * t.g_p[m];
-                    q[SlotLayout::kPd + m] = t.g_p[m];
-                    q[SlotLayout::kTw + m] = t.g_tw[m];
-                    q[SlotLayout::kNormal + m] = r.grad.w * s.g_normal[m];
-                }
-                q[SlotLayout::kCenter] = t.g_center.x;
-                q[SlotLayout::kCenter + 1] = t.g_center.y;
-                q[SlotLayout::kOpacity] = t.g_opacity;
-                for (int c = 0; c < C; ++c) q[SlotLayout::kColor + c] = r.grad.w * s.g_color[c];
+                raster::slot_values(t, r.grad, s, q);
                 for (int m = SlotLayout::values(C); m < kPadded; ++m) q[m] = P(T(0));
                 add_lane_sums<kPadded>(q, &scratch.grads[std::size_t(r.k) * kPadded]);
             }

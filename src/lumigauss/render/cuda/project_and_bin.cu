@@ -98,8 +98,8 @@ __global__ void tile_lengths_kernel(int num_tiles, const std::uint32_t* __restri
     ids[t] = std::uint32_t(t);
 }
 
-// One thread per surfel: the sum of its (surfel, tile) slots in emission order, then the CPU backend's
-// conversion to the surfel's gradients (to_ray_transform_grad, project_surfel_vjp_lanes, in float).
+// One thread per surfel: the sum of its (surfel, tile) slots in emission order, then their conversion to
+// the surfel's gradients (gradient_slot.h, in float as on the CPU).
 template <int kValues>
 __global__ void reduce_kernel(std::size_t n, int channels, raster::PinholeView<float> view,
                               const float* __restrict__ quats, const float* __restrict__ scales,
@@ -110,8 +110,8 @@ __global__ void reduce_kernel(std::size_t n, int channels, raster::PinholeView<f
                               float* d_colors, float* d_mean2d) {
     const std::size_t i = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i >= n) return;
-    using S = SlotValues;
-    const int values = S::count(channels);
+    using S = raster::GradSlot;
+    const int values = S::values(channels);
     float sum[kValues];
 #pragma unroll
     for (int v = 0; v < kValues; ++v) sum[v] = 0.0f;
@@ -133,30 +133,18 @@ __global__ void reduce_kernel(std::size_t n, int channels, raster::PinholeView<f
         d_mean2d[2 * i] = d_mean2d[2 * i + 1] = 0.0f;
         return;
     }
-    const auto vec3 = [&](int k) { return Vec3<float>{sum[k], sum[k + 1], sum[k + 2]}; };
-    raster::SplatGrad<float> sg;
-    sg.pa = vec3(S::kPa), sg.pb = vec3(S::kPb), sg.pd = vec3(S::kPd), sg.tw = vec3(S::kTw);
-    sg.center = {sum[S::kCenter], sum[S::kCenter + 1]};
-    sg.opacity = sum[S::kOpacity];
-    raster::ProjectedSurfelGrad<float> pg{};
-    pg.normal = vec3(S::kNormal);
-    const raster::ProjectionVjpInputs<float> ps = projections[i];
-    float g_opacity = 0.0f;
-    raster::to_ray_transform_grad(ps.tu, ps.tv, ps.tw, ps.center, sg, pg, g_opacity);
-    const raster::SurfelGeometry<float> geometry{
-        {0.0f, 0.0f, 0.0f},  // the mean: the backward does not read it
-        {quats[4 * i], quats[4 * i + 1], quats[4 * i + 2], quats[4 * i + 3]},
-        scales[2 * i],
-        scales[2 * i + 1]};
-    const auto gg = raster::project_surfel_vjp_lanes(geometry, view, ps, pg);
+    const raster::SurfelSlotGrad<float> g = raster::surfel_grad_from_slots(
+        [&](int k) { return sum[k]; }, projections[i],
+        Vec4<float>{quats[4 * i], quats[4 * i + 1], quats[4 * i + 2], quats[4 * i + 3]}, scales[2 * i],
+        scales[2 * i + 1], view);
+    const raster::SurfelGeometryGrad<float>& gg = g.geometry;
     for (int k = 0; k < 3; ++k) d_means[3 * i + k] = gg.mean[k];
     for (int k = 0; k < 4; ++k) d_quats[4 * i + k] = gg.quat[k];
     d_scales[2 * i] = gg.scale_u;
     d_scales[2 * i + 1] = gg.scale_v;
-    d_opacities[i] = g_opacity;
-    // Screen-space gradient for densification, as on the CPU (rasterizer_cpu.cpp).
-    d_mean2d[2 * i] = pg.tu.z * ps.tw.z;
-    d_mean2d[2 * i + 1] = pg.tv.z * ps.tw.z;
+    d_opacities[i] = g.opacity;
+    d_mean2d[2 * i] = g.mean2d.x;
+    d_mean2d[2 * i + 1] = g.mean2d.y;
 #pragma unroll
     for (int c = 0; c < kValues - S::kColor; ++c)  // compile-time indices keep `sum` in registers
         if (c < channels) d_colors[i * channels + c] = sum[S::kColor + c];
@@ -257,11 +245,12 @@ void reduce_surfel_gradients(RasterStateCuda& st, cudaStream_t stream) {
     st.d_opacities.resize(n), st.d_colors.resize(n * c), st.d_mean2d.resize(2 * n);
     if (n == 0) return;
     with_channel_capacity(c, [&](auto capacity) {
-        reduce_kernel<SlotValues::count(decltype(capacity)::value)><<<blocks_for(n), kThreads, 0, stream>>>(
-            n, c, st.view_f, st.quats.data(), st.scales.data(), st.projections.data(),
-            st.tiles_touched.data(), st.emission_offset.data(), st.slots.data(), st.d_means.data(),
-            st.d_quats.data(), st.d_scales.data(), st.d_opacities.data(), st.d_colors.data(),
-            st.d_mean2d.data());
+        reduce_kernel<raster::GradSlot::values(decltype(capacity)::value)>
+            <<<blocks_for(n), kThreads, 0, stream>>>(
+                n, c, st.view_f, st.quats.data(), st.scales.data(), st.projections.data(),
+                st.tiles_touched.data(), st.emission_offset.data(), st.slots.data(), st.d_means.data(),
+                st.d_quats.data(), st.d_scales.data(), st.d_opacities.data(), st.d_colors.data(),
+                st.d_mean2d.data());
     });
     check_launch("reduce_kernel");
 }

@@ -6,6 +6,7 @@
 
 #include "lumigauss/render/cuda/device_buffer.cuh"
 #include "lumigauss/render/cuda/rasterizer_cuda.h"
+#include "lumigauss/render/gradient_slot.h"
 #include "lumigauss/render/raster_types.h"
 
 namespace lumigauss::cuda {
@@ -41,17 +42,11 @@ struct RasterStateCuda {
     DeviceBuffer<std::uint32_t> contributors;
     DeviceBuffer<std::int32_t> median_entry;
 
-    // Backward: incoming map gradients, the (surfel, tile) slots, the surfels' gradients.
+    // Backward: incoming map gradients, the (surfel, tile) slots (gradient_slot.h, unpadded), the surfels'
+    // gradients.
     DeviceBuffer<float> g_color, g_alpha, g_depth, g_median_depth, g_normal, g_distortion;
     DeviceBuffer<float> slots;
     DeviceBuffer<float> d_means, d_quats, d_scales, d_opacities, d_colors, d_mean2d;
-};
-
-// Values of one (surfel, tile) gradient slot (the CPU backend's SlotLayout, unpadded).
-struct SlotValues {
-    static constexpr int kPa = 0, kPb = 3, kPd = 6, kTw = 9, kCenter = 12, kNormal = 14, kOpacity = 17,
-                         kColor = 18;
-    static constexpr int count(int channels) { return kColor + channels; }
 };
 
 // The kernels are compiled for 3, 6 and kMaxChannels colour channels (register arrays need a compile-time

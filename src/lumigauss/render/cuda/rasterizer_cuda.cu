@@ -82,11 +82,8 @@ CudaRasterizer::~CudaRasterizer() = default;
 
 void CudaRasterizer::forward(const Camera& camera, const SurfelBatch<float>& surfels,
                              const RasterSettings<float>& settings, RasterImages<float>& images) {
-    const int channels = surfels.channels;
-    if (channels < 1 || channels > kMaxChannels)
-        throw Error("the CUDA rasterizer supports 1 to " + std::to_string(kMaxChannels) +
-                    " colour channels, not " + std::to_string(channels));
     check_surfel_batch(surfels);
+    const int channels = surfels.channels;
     if (!settings.background.empty() && int(settings.background.size()) != channels)
         throw Error("CUDA rasterizer: the background has " + std::to_string(settings.background.size()) +
                     " values for " + std::to_string(channels) + " channels");
@@ -95,14 +92,7 @@ void CudaRasterizer::forward(const Camera& camera, const SurfelBatch<float>& sur
     const cudaStream_t stream = m.stream;
     // As the CPU backend: the view rounded to float, and the projection in double from that.
     st.view_f = pinhole_view<float>(camera);
-    st.view = {st.view_f.rotation.cast<double>(),
-               st.view_f.translation.cast<double>(),
-               double(st.view_f.fx),
-               double(st.view_f.fy),
-               double(st.view_f.cx),
-               double(st.view_f.cy),
-               camera.width,
-               camera.height};
+    st.view = raster::cast_view<double>(st.view_f);
     st.width = camera.width, st.height = camera.height, st.channels = channels;
     st.tiles_x = (camera.width + raster::kTileSize - 1) / raster::kTileSize;
     st.tiles_y = (camera.height + raster::kTileSize - 1) / raster::kTileSize;

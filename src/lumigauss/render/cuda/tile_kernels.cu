@@ -214,8 +214,7 @@ constexpr int kBackwardBatch = 32;
 
 template <int C>
 __global__ void __launch_bounds__(kTileThreads) backward_kernel(TileArgs a, BackwardInputs in) {
-    constexpr int kValues = SlotValues::count(C);
-    using S = SlotValues;
+    constexpr int kValues = raster::GradSlot::values(C);
     __shared__ StagedEntries<kBackwardBatch, C> staged;
     __shared__ std::uint32_t emission[kBackwardBatch];
     __shared__ float warp_sums[kWarps][kBackwardBatch][kValues];
@@ -229,7 +228,7 @@ __global__ void __launch_bounds__(kTileThreads) backward_kernel(TileArgs a, Back
     atomicMax(&most_contributors, std::uint32_t(s.contributors));
     __syncthreads();
     const std::uint32_t begin = a.tile_start[p.tile];
-    const int values = S::count(a.channels);
+    const int values = raster::GradSlot::values(a.channels);
     // Back to front over the entries up to the last any pixel composited.
     for (std::uint32_t batch_end = begin + most_contributors; batch_end > begin;) {
         const std::uint32_t batch_begin = batch_end - min(std::uint32_t(kBackwardBatch), batch_end - begin);
@@ -263,19 +262,7 @@ __global__ void __launch_bounds__(kTileThreads) backward_kernel(TileArgs a, Back
             const raster::SplatGradTerms<float> t =
                 raster::splat_grad_terms(g, px, py, smp, smp.screen_branch || !composited, r.g_alpha, r.g_z);
             float q[kValues];
-#pragma unroll
-            for (int m = 0; m < 3; ++m) {
-                q[S::kPa + m] = t.dx * t.g_p[m];
-                q[S::kPb + m] = t.dy * t.g_p[m];
-                q[S::kPd + m] = t.g_p[m];
-                q[S::kTw + m] = t.g_tw[m];
-                q[S::kNormal + m] = r.w * s.g_normal[m];
-            }
-            q[S::kCenter] = t.g_center.x;
-            q[S::kCenter + 1] = t.g_center.y;
-            q[S::kOpacity] = t.g_opacity;
-#pragma unroll
-            for (int c = 0; c < C; ++c) q[S::kColor + c] = r.w * s.g_color[c];
+            raster::slot_values(t, r, s, q);
             warp_sum_into(q, sums, lane);
         }
         __syncthreads();
@@ -339,7 +326,7 @@ void blend_tiles(RasterStateCuda& st, cudaStream_t stream) {
 
 void backward_tiles(RasterStateCuda& st, cudaStream_t stream) {
     // Slots of entries behind every pixel's last contributor are never written: zero.
-    st.slots.resize(st.entries * std::size_t(SlotValues::count(st.channels)));
+    st.slots.resize(st.entries * std::size_t(raster::GradSlot::values(st.channels)));
     st.slots.clear(stream);
     BackwardInputs in{};
     for (int c = 0; c < kMaxChannels; ++c) in.background[c] = st.background[c];
