@@ -14,6 +14,7 @@
 #include <type_traits>
 
 #include "lumigauss/math/exp2_eighths.h"
+#include "lumigauss/render/cpu/streaming_store.h"
 
 namespace lumigauss::cpu {
 
@@ -210,6 +211,11 @@ inline Int8<T> load_lanes(const typename Int8<T>::I* p) {
 template <typename T>
 inline void store_pack(T* p, Pack8<T> x) {
     std::memcpy(p, &x.v, sizeof(x.v));
+}
+// store_pack past the caches (streaming_store.h); p aligned to 16 bytes.
+template <typename T>
+inline void stream_pack(T* p, Pack8<T> x) {
+    stream_store(reinterpret_cast<typename Pack8<T>::V*>(p), x.v);
 }
 
 }  // namespace lumigauss::cpu

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <string>
 
 #include "lumigauss/render/cpu/multiversion.h"
@@ -203,6 +204,16 @@ double lap_ms(std::chrono::steady_clock::time_point& start) {
     return ms;
 }
 
+// Room for `values` slot values in `buffer`, from a cache line's start (the tiles stream whole lines).
+template <typename T>
+T* slots_in(std::vector<T>& buffer, std::size_t values) {
+    constexpr std::size_t align = cpu::SlotLayout::kAlign;
+    resize_for_overwrite(buffer, values + align / sizeof(T));
+    void* start = buffer.data();
+    std::size_t space = buffer.size() * sizeof(T);
+    return static_cast<T*>(std::align(align, values * sizeof(T), start, space));
+}
+
 template <typename T>
 LG_ALWAYS_INLINE void write_zero_gradients(SurfelGrads<T>& out, std::size_t i, int channels) {
     std::fill_n(&out.means[3 * i], 3, T(0));
@@ -225,6 +236,7 @@ LG_ALWAYS_INLINE void reduce_lanes(const SurfelBatch<T>& surfels, const RasterSt
     constexpr int N = cpu::kLanes;
     const int C = surfels.channels;
     const int stride = Slot::stride(C);  // a multiple of the pack width
+    const int line = Slot::line_stride(C);
     alignas(64) T sums[Slot::stride(kMaxChannels)][N];
     // Per lane: the projection's rows (tu, tv, tw), filter centre, flip; the quaternion and scales.
     enum { kTu = 0, kTv = 3, kTw = 6, kCentre = 9, kFlip = 11, kQuat = 12, kScale = 16, kInputs = 18 };
@@ -235,7 +247,7 @@ LG_ALWAYS_INLINE void reduce_lanes(const SurfelBatch<T>& surfels, const RasterSt
         alignas(64) T sum[Slot::stride(kMaxChannels)];  // cleared by packs (`= {}` became a `rep stos`)
         for (int k = 0; k < stride; k += N) cpu::store_pack(sum + k, P(T(0)));
         for (std::uint32_t em = st.emission_offset[i]; em < st.emission_offset[i + 1]; ++em) {
-            const T* slot = &slots[std::size_t(em) * stride];
+            const T* slot = &slots[std::size_t(em) * line];
             for (int k = 0; k < stride; k += N)
                 cpu::store_pack(sum + k, cpu::load_pack(sum + k) + cpu::load_pack(slot + k));
         }
@@ -281,16 +293,17 @@ LG_ALWAYS_INLINE void reduce_range(const SurfelBatch<T>& surfels, const RasterSt
                                    SurfelGrads<T>& out, std::size_t begin, std::size_t end) {
     std::uint32_t ids[cpu::kLanes];
     int count = 0;
-    const int stride = cpu::SlotLayout::stride(surfels.channels);
+    const int line = cpu::SlotLayout::line_stride(surfels.channels);
+    const int summed = cpu::SlotLayout::stride(surfels.channels);  // the values reduce_lanes reads
     for (std::size_t i = begin; i != end; ++i) {
         if (i + kReduceAhead < end && st.visible[i + kReduceAhead]) {  // a visible surfel has a slot
             const std::size_t ahead = i + kReduceAhead;
             const char* projection = reinterpret_cast<const char*>(&st.projections[ahead]);
             __builtin_prefetch(projection);
             __builtin_prefetch(projection + sizeof(raster::ProjectionVjpInputs<T>) - 1);
-            const T* slot = &slots[std::size_t(st.emission_offset[ahead]) * stride];
+            const T* slot = &slots[std::size_t(st.emission_offset[ahead]) * line];
             __builtin_prefetch(slot);
-            __builtin_prefetch(slot + stride - 1);
+            __builtin_prefetch(slot + summed - 1);
         }
         if (!st.visible[i]) {
             write_zero_gradients(out, i, surfels.channels);
@@ -375,10 +388,9 @@ void backward_into(const SurfelBatch<T>& surfels, const RasterState<T>& st, cons
                     std::to_string(st.visible.size()));
     auto clock = std::chrono::steady_clock::now();
     const std::size_t n = surfels.size();
-    const int stride = cpu::SlotLayout::stride(surfels.channels);
     // Every slot is written by its tile (zeros for entries no pixel reached), so no clearing here.
-    resize_for_overwrite(slot_buffer, st.intersections() * std::size_t(stride));
-    T* slots = slot_buffer.data();
+    T* const slots =
+        slots_in(slot_buffer, st.intersections() * cpu::SlotLayout::line_stride(surfels.channels));
     const int num_tiles = st.tiles_x * st.tiles_y;
     tbb::enumerable_thread_specific<cpu::TileScratch<T>> scratch;
     tbb::parallel_for(tbb::blocked_range<int>(0, num_tiles, 1), [&](const auto& r) {

@@ -20,6 +20,10 @@ namespace lumigauss::cpu {
 struct SlotLayout : raster::GradSlot {
     // Slots are whole packs (the padding holds zeros), so that they are summed and copied as packs.
     static constexpr int stride(int channels) { return (values(channels) + kLanes - 1) / kLanes * kLanes; }
+    // The slots' spacing in the gradient buffer: whole 64-byte cache lines (16 values: one line in float,
+    // two in double), so that the tiles write them past the caches in full lines (render_tile_backward).
+    static constexpr int line_stride(int channels) { return (values(channels) + 15) / 16 * 16; }
+    static constexpr std::size_t kAlign = 64;  // bytes: where the buffer starts
 };
 
 template <typename T>
@@ -181,13 +185,20 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
             }
         }
     }
-    // Slots are indexed by emission (contiguous per surfel) so the per-surfel reduction streams.
+    // Slots are indexed by emission (contiguous per surfel) so the per-surfel reduction streams. These
+    // writes land all over the buffer: through the caches, each first fetched its line from memory (a
+    // tenth of the backward's tiles); streamed, whole lines go straight out (the padding as zeros).
+    const int line = SlotLayout::line_stride(channels);
     for (std::uint32_t k = 0; k < count; ++k) {
         const T* from = &scratch.grads[std::size_t(k) * kPadded];
-        T* to = &slots[std::size_t(st.entry_emission[begin + k]) * stride];
-        for (int j = 0; j < (C == kMaxChannels ? stride : kPadded); j += kLanes)  // fixed length for 3 and 6
-            store_pack(to + j, load_pack(from + j));
+        T* to = &slots[std::size_t(st.entry_emission[begin + k]) * line];
+        int j = 0;
+        for (; j < (C == kMaxChannels ? stride : kPadded); j += kLanes)  // fixed length for 3 and 6
+            stream_pack(to + j, load_pack(from + j));
+        for (; j < (C == kMaxChannels ? line : SlotLayout::line_stride(C)); j += kLanes)
+            stream_pack(to + j, Pack8<T>(T(0)));
     }
+    stream_fence();
 }
 
 }  // namespace lumigauss::cpu
