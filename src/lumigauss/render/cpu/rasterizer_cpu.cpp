@@ -179,7 +179,11 @@ void gather_entries(const SurfelBatch<T>& surfels, RasterState<T>& st) {
             const std::uint32_t id = st.entry_surfel[e];
             st.entry_splat[e] = st.splats[id];
             st.entry_footprint[e] = st.footprints[id];
-            std::copy_n(&surfels.colors[std::size_t(id) * C], C, &st.entry_color[e * C]);
+            const T* color = &surfels.colors[std::size_t(id) * C];
+            if (C == 3)  // a copy of known length: std::copy_n of C values was a call to memmove per entry
+                std::copy_n(color, 3, &st.entry_color[e * 3]);
+            else
+                std::copy_n(color, C, &st.entry_color[e * C]);
         }
     });
 }
