@@ -224,7 +224,10 @@ LG_ALWAYS_INLINE void write_zero_gradients(SurfelGrads<T>& out, std::size_t i, i
     std::fill_n(&out.quats[4 * i], 4, T(0));
     std::fill_n(&out.scales[2 * i], 2, T(0));
     out.opacities[i] = T(0);
-    std::fill_n(&out.colors[i * channels], channels, T(0));
+    if (channels == 3)  // a fill of known length: of a run-time length it was a call to memset
+        std::fill_n(&out.colors[i * 3], 3, T(0));
+    else
+        std::fill_n(&out.colors[i * channels], channels, T(0));
     std::fill_n(&out.mean2d[2 * i], 2, T(0));
 }
 
@@ -288,35 +291,41 @@ LG_ALWAYS_INLINE void reduce_lanes(const SurfelBatch<T>& surfels, const RasterSt
     }
 }
 
-// Per surfel: the gradients of the visible ones (reduce_lanes, eight at a time), zeros for the others.
-// What the surfels kReduceAhead places further need is asked for early: the visible surfels are scattered
-// among the others, and the hardware's stream prefetch did not keep up (the loads of the projection waited).
-constexpr std::size_t kReduceAhead = 16;
+// Per surfel: the gradients of the visible ones (reduce_lanes, eight at a time), zeros for the others. A
+// chunk of surfels at a time is split into the two kinds first, without branches (which kind a surfel is
+// follows no pattern the branch predictor could learn), then each kind runs in a loop of its own. What the
+// visible surfels kReduceAhead places further need is asked for early: they are scattered among the others,
+// and the hardware's stream prefetch did not keep up (the loads of the projection waited).
+constexpr int kReduceAhead = 16;
+constexpr std::size_t kReduceChunk = 256;
 template <typename T>
 LG_ALWAYS_INLINE void reduce_range(const SurfelBatch<T>& surfels, const RasterState<T>& st, const T* slots,
                                    SurfelGrads<T>& out, std::size_t begin, std::size_t end) {
-    std::uint32_t ids[cpu::kLanes];
-    int count = 0;
     const int line = cpu::SlotLayout::line_stride(surfels.channels);
     const int summed = cpu::SlotLayout::stride(surfels.channels);  // the values reduce_lanes reads
-    for (std::size_t i = begin; i != end; ++i) {
-        if (i + kReduceAhead < end && st.visible[i + kReduceAhead]) {  // a visible surfel has a slot
-            const std::size_t ahead = i + kReduceAhead;
-            const char* projection = reinterpret_cast<const char*>(&st.projections[ahead]);
-            __builtin_prefetch(projection);
-            __builtin_prefetch(projection + sizeof(raster::ProjectionVjpInputs<T>) - 1);
-            const T* slot = &slots[std::size_t(st.emission_offset[ahead]) * line];
-            __builtin_prefetch(slot);
-            __builtin_prefetch(slot + summed - 1);
+    std::uint32_t visible[kReduceChunk], hidden[kReduceChunk];
+    for (std::size_t chunk = begin; chunk < end; chunk += kReduceChunk) {
+        int num_visible = 0, num_hidden = 0;
+        for (std::size_t i = chunk; i < std::min(end, chunk + kReduceChunk); ++i) {
+            visible[num_visible] = hidden[num_hidden] = std::uint32_t(i);
+            num_visible += st.visible[i] != 0;
+            num_hidden += st.visible[i] == 0;
         }
-        if (!st.visible[i]) {
-            write_zero_gradients(out, i, surfels.channels);
-            continue;
+        for (int j = 0; j < num_hidden; ++j) write_zero_gradients(out, hidden[j], surfels.channels);
+        for (int first = 0; first < num_visible; first += cpu::kLanes) {
+            const int ahead = first == 0 ? 0 : first + kReduceAhead;  // the chunk's first ones too
+            for (int j = ahead; j < std::min(num_visible, first + kReduceAhead + cpu::kLanes); ++j) {
+                const char* projection = reinterpret_cast<const char*>(&st.projections[visible[j]]);
+                __builtin_prefetch(projection);
+                __builtin_prefetch(projection + sizeof(raster::ProjectionVjpInputs<T>) - 1);
+                const T* slot = &slots[std::size_t(st.emission_offset[visible[j]]) * line];
+                __builtin_prefetch(slot);
+                __builtin_prefetch(slot + summed - 1);
+            }
+            reduce_lanes(surfels, st, slots, out, &visible[first],
+                         std::min(cpu::kLanes, num_visible - first));
         }
-        ids[count++] = std::uint32_t(i);
-        if (count == cpu::kLanes) reduce_lanes(surfels, st, slots, out, ids, count), count = 0;
     }
-    if (count > 0) reduce_lanes(surfels, st, slots, out, ids, count);
 }
 
 LG_FLATTEN LG_MULTIVERSION void reduce_surfels(const SurfelBatch<float>& surfels,
