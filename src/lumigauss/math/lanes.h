@@ -61,6 +61,16 @@ LG_HD_INLINE double lane_exp(double x) {
     return std::exp(x);
 }
 
+// x = m 2^e with sqrt(1/2) <= m < sqrt(2), for a positive normal x (log_positive's reduction); returns e.
+template <typename T>
+LG_HD_INLINE T lane_split_exponent(T x, T& m) {
+    int e;
+    m = std::frexp(x, &e);  // m in [1/2, 1)
+    const bool low = m < T(0.70710678118654752440);
+    m = low ? m + m : m;
+    return T(low ? e - 1 : e);
+}
+
 // True where x is finite (x - x is 0 for finite x, NaN for infinities and NaN). Needs IEEE semantics
 // (no -ffinite-math-only), which the project keeps.
 template <typename L>

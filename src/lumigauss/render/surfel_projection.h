@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "lumigauss/math/lanes.h"
+#include "lumigauss/math/log_positive.h"
 #include "lumigauss/math/quaternion.h"
 #include "lumigauss/math/vec.h"
 #include "lumigauss/render/raster_constants.h"
@@ -116,10 +117,12 @@ LG_HD_INLINE ConicBox<L> conic_box(Vec3<L> tu, Vec3<L> tv, Vec3<L> tw, L c2, L d
 // The largest rho = min(rho_object, rho_screen) at which a surfel of this opacity still reaches alpha
 // kAlphaMin: opacity * exp(-rho / 2) >= kAlphaMin. Negative when it never does. A hair of slack, so that
 // work skipped on this bound is never work the exact alpha test would keep.
-template <typename T>
-LG_HD_INLINE T reach_rho(T opacity) {
-    const T ratio = opacity / T(kAlphaMin);
-    return ratio > T(1) ? T(2) * std::log(ratio) * T(1.0001) + T(1e-6) : T(-1);
+template <typename L>
+LG_HD_INLINE L reach_rho(L opacity) {
+    const L ratio = opacity / L(kAlphaMin);
+    const auto reaches = ratio > L(1);
+    const L rho = L(2) * log_positive(lane_select(reaches, ratio, L(1))) * L(1.0001) + L(1e-6);
+    return lane_select(reaches, rho, L(-1));
 }
 
 // A world-to-camera rotation (of the view's scalar type V) applied to a vector of lanes.

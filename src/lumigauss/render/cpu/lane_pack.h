@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <type_traits>
 
 #include "lumigauss/math/exp2_eighths.h"
@@ -149,6 +150,23 @@ inline Pack8<float> exp2_eighths(Pack8<float> shifted) {
                                    kExp2Eighths[4], kExp2Eighths[5], kExp2Eighths[6], kExp2Eighths[7]};
     const IV bits = (IV)__builtin_shuffle(table, n) + (n >> 3) * (1 << 23);
     return {(Pack8<float>::V)bits};
+}
+
+// lane_split_exponent (math/lanes.h) per lane, from the bits: the exponent field, and the mantissa with the
+// exponent of 1/2.
+template <typename T, int N>
+inline Pack<T, N> lane_split_exponent(Pack<T, N> x, Pack<T, N>& m) {
+    using IV = typename LaneInt<T, N>::V;
+    using I = typename LaneInt<T, N>::I;
+    constexpr int kMantissaBits = std::numeric_limits<T>::digits - 1;
+    constexpr I kMantissa = (I(1) << kMantissaBits) - 1;
+    constexpr I kHalfExponent = I(std::numeric_limits<T>::max_exponent - 2) << kMantissaBits;  // of 1/2
+    const IV bits = (IV)x.v;  // GCC vector cast: the same bits reinterpreted
+    const Pack<T, N> mantissa{(typename Pack<T, N>::V)((bits & kMantissa) | kHalfExponent)};  // [1/2, 1)
+    const LaneInt<T, N> e{(bits >> kMantissaBits) - (std::numeric_limits<T>::max_exponent - 2)};
+    const LaneInt<T, N> low = mantissa < Pack<T, N>(T(0.70710678118654752440));
+    m = lane_select(low, mantissa + mantissa, mantissa);
+    return Pack<T, N>{__builtin_convertvector((e.v + low.v), typename Pack<T, N>::V)};  // a true mask is -1
 }
 
 // exp per lane in double (the reference path only).

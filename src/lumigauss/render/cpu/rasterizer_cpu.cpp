@@ -90,8 +90,8 @@ LG_ALWAYS_INLINE void project_candidates(const SurfelBatch<T>& surfels, RasterSt
             g.scale_u.v[l] = double(gi.scale_u);
             g.scale_v.v[l] = double(gi.scale_v);
             opacity.v[l] = double(surfels.opacities[i]);
-            reach.v[l] = raster::reach_rho(opacity.v[l]);
         }
+        reach = raster::reach_rho(opacity);
         raster::ProjectionLanes<P> p;
         const auto visible = raster::project_surfel_lanes(g, reach, view, p);
         for (int l = 0; l < P::kSize && first + l < count; ++l) {
