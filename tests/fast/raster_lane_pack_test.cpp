@@ -1,5 +1,6 @@
-// The CPU backend's lane helpers against plain loops: the transpose-add tree of lane_sums (its shuffle
-// patterns are easy to get subtly wrong: a lane summed twice, another never) and the whole-pack loads.
+// The CPU backend's lane helpers against plain loops: the transpose-add tree of lane_sums and the 8x8
+// transpose (their shuffle patterns are easy to get subtly wrong: a lane summed twice or moved to the
+// wrong place, another never) and the whole-pack loads.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -35,6 +36,21 @@ void check_lane_sums() {
 TEST(LanePack, LaneSumsSumEveryLaneOfEachPackOnce) {
     check_lane_sums<float>();
     check_lane_sums<double>();
+}
+
+template <typename T>
+void check_transpose() {
+    Pack8<T> m[kLanes];
+    for (int r = 0; r < kLanes; ++r)
+        for (int c = 0; c < kLanes; ++c) m[r].v[c] = T(10 * r + c);  // every element its own value
+    transpose_packs(m);
+    for (int r = 0; r < kLanes; ++r)
+        for (int c = 0; c < kLanes; ++c) EXPECT_EQ(m[r][c], T(10 * c + r)) << "row " << r << ", column " << c;
+}
+
+TEST(LanePack, TransposePacksSwapsRowsAndColumns) {
+    check_transpose<float>();
+    check_transpose<double>();
 }
 
 TEST(LanePack, LoadLanesReadsEightIndicesInOrder) {

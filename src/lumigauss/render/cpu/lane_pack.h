@@ -191,6 +191,33 @@ inline Pack8<T> pixel_centres(Int8<T> x) {
     return Pack8<T>{__builtin_convertvector(x.v, typename Pack8<T>::V)} + Pack8<T>(T(0.5));
 }
 
+// The 8x8 matrix of eight packs (pack r = row r) transposed in place: three levels of two-source shuffles.
+template <typename T>
+inline void transpose_packs(Pack8<T> (&m)[kLanes]) {
+    using IV = typename Int8<T>::V;
+    const auto mix = [](Pack8<T> a, Pack8<T> b, IV order) {
+        return Pack8<T>{__builtin_shuffle(a.v, b.v, order)};
+    };
+    const IV lo1{0, 8, 1, 9, 4, 12, 5, 13}, hi1{2, 10, 3, 11, 6, 14, 7, 15};  // pairs of rows interleaved
+    const IV lo2{0, 1, 8, 9, 4, 5, 12, 13}, hi2{2, 3, 10, 11, 6, 7, 14, 15};  // then pairs of pairs
+    const IV lo3{0, 1, 2, 3, 8, 9, 10, 11}, hi3{4, 5, 6, 7, 12, 13, 14, 15};  // then halves
+    Pack8<T> t[kLanes], u[kLanes];
+    for (int p = 0; p < 4; ++p) {
+        t[2 * p] = mix(m[2 * p], m[2 * p + 1], lo1);
+        t[2 * p + 1] = mix(m[2 * p], m[2 * p + 1], hi1);
+    }
+    for (int q = 0; q < 2; ++q) {
+        u[4 * q] = mix(t[4 * q], t[4 * q + 2], lo2);
+        u[4 * q + 1] = mix(t[4 * q], t[4 * q + 2], hi2);
+        u[4 * q + 2] = mix(t[4 * q + 1], t[4 * q + 3], lo2);
+        u[4 * q + 3] = mix(t[4 * q + 1], t[4 * q + 3], hi2);
+    }
+    for (int k = 0; k < 4; ++k) {
+        m[k] = mix(u[k], u[4 + k], lo3);
+        m[4 + k] = mix(u[k], u[4 + k], hi3);
+    }
+}
+
 // Sums of the lanes of eight packs: lane j of the result is the sum of the lanes of q[j]. A transpose-add
 // tree (three levels of two-source shuffles), far cheaper than eight separate horizontal sums.
 template <typename T>

@@ -245,20 +245,20 @@ LG_ALWAYS_INLINE void reduce_lanes(const SurfelBatch<T>& surfels, const RasterSt
     const int stride = Slot::stride(C);  // a multiple of the pack width
     const int line = Slot::line_stride(C);
     alignas(64) T sums[Slot::stride(kMaxChannels)][N];
+    alignas(64) T lane_sums[N][Slot::stride(kMaxChannels)];  // the same, lane by lane (transposed below)
     // Per lane: the projection's rows (tu, tv, tw), filter centre, flip; the quaternion and scales.
     enum { kTu = 0, kTv = 3, kTw = 6, kCentre = 9, kFlip = 11, kQuat = 12, kScale = 16, kInputs = 18 };
     alignas(64) T in[kInputs][N];
     alignas(64) typename cpu::Int8<T>::I conic[N];
     for (int l = 0; l < N; ++l) {
         const std::uint32_t i = ids[std::min(l, count - 1)];
-        alignas(64) T sum[Slot::stride(kMaxChannels)];  // cleared by packs (`= {}` became a `rep stos`)
+        T* const sum = lane_sums[l];  // cleared by packs (`= {}` became a `rep stos`)
         for (int k = 0; k < stride; k += N) cpu::store_pack(sum + k, P(T(0)));
         for (std::uint32_t em = st.emission_offset[i]; em < st.emission_offset[i + 1]; ++em) {
             const T* slot = &slots[std::size_t(em) * line];
             for (int k = 0; k < stride; k += N)
                 cpu::store_pack(sum + k, cpu::load_pack(sum + k) + cpu::load_pack(slot + k));
         }
-        for (int k = 0; k < Slot::values(C); ++k) sums[k][l] = sum[k];
         const raster::ProjectionVjpInputs<T>& ps = st.projections[i];
         for (int k = 0; k < 3; ++k)
             in[kTu + k][l] = ps.tu[k], in[kTv + k][l] = ps.tv[k], in[kTw + k][l] = ps.tw[k];
@@ -267,6 +267,14 @@ LG_ALWAYS_INLINE void reduce_lanes(const SurfelBatch<T>& surfels, const RasterSt
         conic[l] = ps.conic_center ? -1 : 0;
         for (int k = 0; k < 4; ++k) in[kQuat + k][l] = surfels.quats[4 * i + k];
         in[kScale][l] = surfels.scales[2 * i], in[kScale + 1][l] = surfels.scales[2 * i + 1];
+    }
+    // The lanes' sums into packs of one value each, eight values at a time by shuffles (copied value by
+    // value, each pack was then loaded from eight separate stores).
+    for (int k = 0; k < stride; k += N) {
+        P block[N];
+        for (int l = 0; l < N; ++l) block[l] = cpu::load_pack(&lane_sums[l][k]);
+        cpu::transpose_packs(block);
+        for (int j = 0; j < N; ++j) cpu::store_pack(sums[k + j], block[j]);
     }
     const auto sum_of = [&](int k) LG_LAMBDA_INLINE { return cpu::load_pack(sums[k]); };
     const auto input = [&](int k) LG_LAMBDA_INLINE { return cpu::load_pack(in[k]); };
