@@ -62,11 +62,13 @@ LG_HD_INLINE double lane_exp(double x) {
 }
 
 // x = m 2^e with sqrt(1/2) <= m < sqrt(2), for a positive normal x (log_positive's reduction); returns e.
+// (The CPU's packs split the bits instead, with the same bound: lane_pack.h.)
+inline constexpr double kSplitMantissaMin = 0.70710678118654752440;  // sqrt(1/2)
 template <typename T>
 LG_HD_INLINE T lane_split_exponent(T x, T& m) {
     int e;
     m = std::frexp(x, &e);  // m in [1/2, 1)
-    const bool low = m < T(0.70710678118654752440);
+    const bool low = m < T(kSplitMantissaMin);
     m = low ? m + m : m;
     return T(low ? e - 1 : e);
 }

@@ -15,6 +15,7 @@
 #include <type_traits>
 
 #include "lumigauss/math/exp2_eighths.h"
+#include "lumigauss/math/lanes.h"
 #include "lumigauss/render/cpu/streaming_store.h"
 
 namespace lumigauss::cpu {
@@ -164,7 +165,7 @@ inline Pack<T, N> lane_split_exponent(Pack<T, N> x, Pack<T, N>& m) {
     const IV bits = (IV)x.v;  // GCC vector cast: the same bits reinterpreted
     const Pack<T, N> mantissa{(typename Pack<T, N>::V)((bits & kMantissa) | kHalfExponent)};  // [1/2, 1)
     const LaneInt<T, N> e{(bits >> kMantissaBits) - (std::numeric_limits<T>::max_exponent - 2)};
-    const LaneInt<T, N> low = mantissa < Pack<T, N>(T(0.70710678118654752440));
+    const LaneInt<T, N> low = mantissa < Pack<T, N>(T(kSplitMantissaMin));
     m = lane_select(low, mantissa + mantissa, mantissa);
     return Pack<T, N>{__builtin_convertvector((e.v + low.v), typename Pack<T, N>::V)};  // a true mask is -1
 }

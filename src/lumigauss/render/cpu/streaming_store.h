@@ -1,7 +1,7 @@
 #pragma once
 // Stores that go past the caches (internal to the CPU backend), for buffers written in one phase and read
 // in a later one: an ordinary store first fetches the line it writes into from memory, which for buffers
-// of tens of MiB is as much traffic again as the writes themselves. Whole 64-byte lines should be written
+// of tens of MiB is as much traffic again as the writes themselves. Whole cache lines should be written
 // (the processor combines the 16-byte pieces); a partly written line costs more than an ordinary store.
 // The writing thread must end with stream_fence() before another thread reads what it wrote.
 #include <cstddef>
@@ -12,6 +12,8 @@
 #endif
 
 namespace lumigauss::cpu {
+
+inline constexpr std::size_t kCacheLineBytes = 64;
 
 // *dst = src, past the caches: sizeof(T) a multiple of 16 bytes, dst aligned to 16 bytes.
 template <typename T>

@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/render/cpu/streaming_store.h"
 #include "lumigauss/render/cpu/tile_forward.h"
 #include "lumigauss/render/gradient_slot.h"
 
@@ -20,10 +21,13 @@ namespace lumigauss::cpu {
 struct SlotLayout : raster::GradSlot {
     // Slots are whole packs (the padding holds zeros), so that they are summed and copied as packs.
     static constexpr int stride(int channels) { return (values(channels) + kLanes - 1) / kLanes * kLanes; }
-    // The slots' spacing in the gradient buffer: whole 64-byte cache lines (16 values: one line in float,
-    // two in double), so that the tiles write them past the caches in full lines (render_tile_backward).
-    static constexpr int line_stride(int channels) { return (values(channels) + 15) / 16 * 16; }
-    static constexpr std::size_t kAlign = 64;  // bytes: where the buffer starts
+    // The slots' spacing in the gradient buffer: whole cache lines (counted in float: one line in float, two
+    // in double), so that the tiles write them past the caches in full lines (render_tile_backward).
+    static constexpr int kLineValues = int(kCacheLineBytes / sizeof(float));
+    static constexpr int line_stride(int channels) {
+        return (values(channels) + kLineValues - 1) / kLineValues * kLineValues;
+    }
+    static constexpr std::size_t kAlign = kCacheLineBytes;  // bytes: where the buffer starts
 };
 
 template <typename T>
