@@ -1,6 +1,7 @@
 #include "lumigauss/eval/holdout_report.h"
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
 namespace lumigauss {
 namespace {

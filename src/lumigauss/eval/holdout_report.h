@@ -17,7 +17,7 @@
 //    "mean": {"shadowed", "unshadowed", "fit_psnr": {"shadowed", "unshadowed"}}, "median_fit_ms",
 //    "median_render_ms"}
 // Non-finite numbers are written as null.
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 
 #include "lumigauss/eval/holdout.h"

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/io/image.h"

@@ -22,7 +22,7 @@
 // Other protocols (sol-nerf: eval/sol_nerf_report.h) write the same three kinds of files with the shared
 // pieces below: the contact sheet of any per-image SheetPanels (the panels a protocol has no ground truth for
 // stay black), the metrics table and JSON of ImageMetrics, and the atomic writers.
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <utility>
 #include <vector>

@@ -1,5 +1,6 @@
 #include "lumigauss/eval/sol_nerf_report.h"
 
+#include <nlohmann/json.hpp>
 #include <numbers>
 
 namespace lumigauss {

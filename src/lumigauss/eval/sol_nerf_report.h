@@ -15,7 +15,7 @@
 //                "shadowed": {"psnr", "ssim", "mse", "mae"}, "unshadowed": {...}, "search_ms", "render_ms"}],
 //    "mean": {"shadowed", "unshadowed"}, "median_render_ms", "search_seconds"}
 // Non-finite numbers are written as null.
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 
 #include "lumigauss/eval/report.h"
