@@ -24,8 +24,8 @@ std::vector<T> test_values(std::uint32_t seed) {
                      T(0.5),
                      std::numeric_limits<T>::min(),
                      std::numeric_limits<T>::max(),
-                     T(0.70710678118654752440),
-                     std::nextafter(T(0.70710678118654752440), T(0))};
+                     T(kSplitMantissaMin),  // where the reduction's mantissa range starts
+                     std::nextafter(T(kSplitMantissaMin), T(0))};
     for (int i = 0; i < 20000; ++i) v.push_back(T(std::exp(lo + (hi - lo) * unit(rng))));
     for (int i = 0; i < 20000; ++i) v.push_back(T(0.5 + 1.5 * unit(rng)));
     return v;
