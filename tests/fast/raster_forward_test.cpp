@@ -303,9 +303,19 @@ TEST(RasterProjection, IntersectionReprojectsToThePixel) {
     }
 }
 
+// The kernel's geometry as the float CPU backend stores it: set up in double, each value rounded.
+raster::SplatGeometry<float> rounded_to_float(const raster::SplatGeometry<double>& g) {
+    const auto vec3 = [](Vec3<double> v) { return v.cast<float>(); };
+    return {
+        vec3(g.pa),       vec3(g.pb),         vec3(g.pd), vec3(g.tw), {float(g.center.x), float(g.center.y)},
+        float(g.opacity), float(g.rho_cutoff)};
+}
+
 TEST(RasterProjection, BoundingBoxHoldsEveryContributingPixel) {
     // Brute force: every pixel where the kernel says the surfel contributes lies inside its box, for
-    // random surfels of every opacity, including ones whose box is clipped by the image border.
+    // random surfels of every opacity, including ones whose box is clipped by the image border. The tile
+    // kernels rely on it: they test no box per pixel, only per block, so the float kernel (the CPU tiles'
+    // own evaluation) must not reach outside the box either.
     const Camera cam = test_camera(48, 40);
     RandomSceneOptions o;
     o.count = 200;
@@ -313,21 +323,29 @@ TEST(RasterProjection, BoundingBoxHoldsEveryContributingPixel) {
     o.min_scale = 0.001, o.max_scale = 0.8;
     const auto s = random_surfels<double>(cam, 8, o);
     const auto view = pinhole_view<double>(cam);
-    int contributing = 0;
+    int contributing = 0, contributing_float = 0;
     for (std::size_t i = 0; i < s.size(); ++i) {
         raster::ProjectedSurfel<double> p;
         if (!raster::project_surfel(s.geometry(i), s.opacities[i], view, p)) continue;
         const auto g = raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, s.opacities[i]);
+        const auto gf = rounded_to_float(g);
         for (int y = 0; y < cam.height; ++y)
             for (int x = 0; x < cam.width; ++x) {
+                const bool inside = x >= p.rect.x0 && x <= p.rect.x1 && y >= p.rect.y0 && y <= p.rect.y1;
                 raster::SplatSample<double> smp;
-                if (!raster::evaluate_splat(g, x + 0.5, y + 0.5, smp)) continue;
-                ++contributing;
-                EXPECT_TRUE(x >= p.rect.x0 && x <= p.rect.x1 && y >= p.rect.y0 && y <= p.rect.y1)
-                    << "surfel " << i << " pixel " << x << "," << y;
+                if (raster::evaluate_splat(g, x + 0.5, y + 0.5, smp)) {
+                    ++contributing;
+                    EXPECT_TRUE(inside) << "surfel " << i << " pixel " << x << "," << y;
+                }
+                raster::SplatSample<float> smp_float;
+                if (raster::evaluate_splat(gf, float(x) + 0.5f, float(y) + 0.5f, smp_float)) {
+                    ++contributing_float;
+                    EXPECT_TRUE(inside) << "float: surfel " << i << " pixel " << x << "," << y;
+                }
             }
     }
     EXPECT_GT(contributing, 1000);
+    EXPECT_GT(contributing_float, 1000);
 }
 
 TEST(RasterProjection, OffScreenCullNeverDropsAContributingSurfel) {

@@ -142,7 +142,7 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
         // entry is the transmittance and the "behind" dot product. It records what the gradient pass
         // needs; that pass (splat_grad_terms and the lane sums, most of the work) has no chain between
         // entries at all either. (One loop doing all of it was latency-bound: an iteration filled the
-        // reorder window.)
+        // reorder window.) As in the forward, no lane tests the entry's pixel box.
         const auto walked = [&](std::uint32_t j)
                                 LG_LAMBDA_INLINE -> std::uint32_t { return kept[first + length - 1 - j]; };
         const auto record = [&](std::uint32_t j)
@@ -157,7 +157,6 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
                 const std::uint32_t e = begin + r.k;
                 P rho;
                 const auto reached = raster::splat_hit(st.entry_splat[e], cx, cy, r.smp, rho) &
-                                     lanes_in(st.entry_footprint[e].rect, px, py) &
                                      (I(typename I::I(r.k + 1)) <= s.contributors);
                 r.smp.alpha = raster::splat_exponent(rho, reached);  // the exponent waits in the alpha field
             }

@@ -91,7 +91,10 @@ LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, RasterState<T>
         // the chain; in loops of their own the halves of the kernel are short enough for the processor to
         // overlap several entries. The results go through L1 as plain arrays (packs held in an array of
         // packs were copied through general registers, in halves). A block that finishes inside a chunk
-        // has evaluated the rest of the chunk for nothing.
+        // has evaluated the rest of the chunk for nothing. No lane tests the entry's pixel box: the kernel
+        // reaches kAlphaMin only inside it (raster_forward_test: BoundingBoxHoldsEveryContributingPixel,
+        // in double and in float), and the block lists hold only the blocks it overlaps. (The test was 5 %
+        // of the forward's and the backward's instructions.)
         alignas(64) T chunk_alpha[kEvaluateChunk * kLanes], chunk_z[kEvaluateChunk * kLanes];
         bool finished = false;
         for (std::size_t chunk = 0; chunk < list.size() && !finished; chunk += kEvaluateChunk) {
@@ -102,8 +105,7 @@ LG_ALWAYS_INLINE void render_tile_forward(int tile, int channels, RasterState<T>
                 const std::uint32_t e = begin + list[n];
                 raster::SplatSample<P> hit;  // only its depth is kept
                 P rho;
-                const auto reached = raster::splat_hit(st.entry_splat[e], cx, cy, hit, rho) &
-                                     lanes_in(st.entry_footprint[e].rect, px, py);
+                const auto reached = raster::splat_hit(st.entry_splat[e], cx, cy, hit, rho);
                 store_pack(&chunk_alpha[(n - chunk) * kLanes], raster::splat_exponent(rho, reached));
                 store_pack(&chunk_z[(n - chunk) * kLanes], hit.z);
             }
