@@ -120,13 +120,16 @@ template <typename L, int C>
 LG_HD_INLINE BlendSampleGrad<L> unblend_sample(BlendPixelBackward<L, C>& s, L a, const SampleValues<L>& v,
                                                LaneIndex<L> entry) {
     const L one_minus_a = L(1) - a;
-    const L t_before = s.trans / one_minus_a;
+    // One division for both quotients: the walk's loop had three (this, the background term's and the
+    // distortion's 1 / z), which kept the divider busier than the rest of the loop.
+    const L inv_one_minus_a = L(1) / one_minus_a;
+    const L t_before = s.trans * inv_one_minus_a;
     const L w = a * t_before;
     const auto composited = a > L(0);
     BlendSampleGrad<L> out;
     out.w = w;
     out.g_alpha =
-        lane_select(composited, t_before * (v.value_dot - s.behind_dot) - s.bg_term / one_minus_a, L(0));
+        lane_select(composited, t_before * (v.value_dot - s.behind_dot) - s.bg_term * inv_one_minus_a, L(0));
     const L g_median = lane_select(s.median_entry == entry, s.g_median, L(0));
     const L g_z = w * s.g_depth + g_median + L(2) * w * (v.m * s.a_total - s.m1) * s.g_dist * v.dm_dz;
     out.g_z = lane_select(composited, g_z, L(0));

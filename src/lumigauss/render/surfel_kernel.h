@@ -88,9 +88,11 @@ LG_HD inline SplatGeometry<T> make_splat_geometry(Vec3<T> tu, Vec3<T> tv, Vec3<T
 template <typename T, typename L>
 LG_HD_INLINE LaneMask<L> splat_hit(const SplatGeometry<T>& g, L px, L py, SplatSample<L>& s, L& rho) {
     const L dx = px - L(g.center.x), dy = py - L(g.center.y);
-    const L p_x = dx * L(g.pa.x) + dy * L(g.pb.x) + L(g.pd.x);
-    const L p_y = dx * L(g.pa.y) + dy * L(g.pb.y) + L(g.pd.y);
-    const L p_z = dx * L(g.pa.z) + dy * L(g.pb.z) + L(g.pd.z);
+    // Grouped so that each sum is two fused multiply-adds (left to right it was a product, a fused
+    // multiply-add and an addition).
+    const L p_x = dx * L(g.pa.x) + (dy * L(g.pb.x) + L(g.pd.x));
+    const L p_y = dx * L(g.pa.y) + (dy * L(g.pb.y) + L(g.pd.y));
+    const L p_z = dx * L(g.pa.z) + (dy * L(g.pb.z) + L(g.pd.z));
     s.inv_pz = L(1) / p_z;
     s.u = p_x * s.inv_pz;
     s.v = p_y * s.inv_pz;
@@ -100,7 +102,7 @@ LG_HD_INLINE LaneMask<L> splat_hit(const SplatGeometry<T>& g, L px, L py, SplatS
     rho = lane_select(s.screen_branch, rho_screen, rho_object);
     // The screen branch uses the centre depth (the pinned rasterizer of the official code): far from the
     // disk, or at grazing angles, the intersection depth is meaningless.
-    s.z = lane_select(s.screen_branch, L(g.tw.z), L(g.tw.x) * s.u + L(g.tw.y) * s.v + L(g.tw.z));
+    s.z = lane_select(s.screen_branch, L(g.tw.z), L(g.tw.x) * s.u + (L(g.tw.y) * s.v + L(g.tw.z)));
     // A ray parallel to the disk (p.z == 0) never contributes.
     const L rho_checked = lane_select(p_z != L(0), rho, L(std::numeric_limits<lane_scalar_t<L>>::infinity()));
     return (rho_checked <= L(g.rho_cutoff)) & (s.z >= L(kNearPlane));  // also false for NaN
@@ -174,18 +176,21 @@ LG_HD_INLINE SplatGradTerms<L> splat_grad_terms(const SplatGeometry<T>& g, L px,
     // The alpha clamp is differentiated exactly: no gradient through a clamped alpha.
     const L ga = lane_select(smp.clamped, L(0), g_alpha);
     t.g_opacity = smp.gauss * ga;
-    const L g_gauss = L(g.opacity) * ga;
+    // gauss * dL/dgauss, which both branches scale.
+    const L gauss_g = smp.gauss * (L(g.opacity) * ga);
     t.dx = px - L(g.center.x);
     t.dy = py - L(g.center.y);
     // Screen branch: gauss = exp(-|pix - c|^2), so d gauss / d c = 2 (pix - c) gauss; z = tw.z.
-    const L k2 = lane_select(screen_branch, L(kFilterInvSquare) * smp.gauss * g_gauss, L(0));
+    const L k2 = lane_select(screen_branch, L(kFilterInvSquare) * gauss_g, L(0));
     t.g_center = {k2 * t.dx, k2 * t.dy};
     // Object branch: gauss = exp(-(u^2 + v^2) / 2), z = tw . (u, v, 1), (u, v) = (p.x, p.y) / p.z.
     const L u = lane_select(screen_branch, L(0), smp.u), v = lane_select(screen_branch, L(0), smp.v);
-    const L g_u = -u * smp.gauss * g_gauss + lane_select(screen_branch, L(0), g_z * L(g.tw.x));
-    const L g_v = -v * smp.gauss * g_gauss + lane_select(screen_branch, L(0), g_z * L(g.tw.y));
+    const L g_u = lane_select(screen_branch, L(0), g_z * L(g.tw.x)) - u * gauss_g;
+    const L g_v = lane_select(screen_branch, L(0), g_z * L(g.tw.y)) - v * gauss_g;
     const L inv_pz = lane_select(screen_branch, L(0), smp.inv_pz);
-    t.g_p = {g_u * inv_pz, g_v * inv_pz, -(g_u * u + g_v * v) * inv_pz};
+    t.g_p.x = g_u * inv_pz;
+    t.g_p.y = g_v * inv_pz;
+    t.g_p.z = -(u * t.g_p.x) - v * t.g_p.y;  // -(g_u u + g_v v) / p.z
     t.g_tw = {g_z * u, g_z * v, g_z};
     return t;
 }
