@@ -285,17 +285,31 @@ LG_ALWAYS_INLINE void reduce_lanes(const SurfelBatch<T>& surfels, const RasterSt
     const raster::SurfelSlotGrad<P> g = raster::surfel_grad_from_slots(
         sum_of, ps, {input(kQuat), input(kQuat + 1), input(kQuat + 2), input(kQuat + 3)}, input(kScale),
         input(kScale + 1), st.view);
+    // The results go out lane by lane from a plain array: read from the packs for a run-time lane, each
+    // value was a copy of the pack's halves to memory and a load back, for every lane.
     const raster::SurfelGeometryGrad<P>& gg = g.geometry;
+    enum { kMean = 0, kQuatOut = 3, kScaleU = 7, kScaleV = 8, kOpacity = 9, kMean2d = 10, kOutputs = 12 };
+    alignas(64) T results[kOutputs][N];
+    for (int k = 0; k < 3; ++k) cpu::store_pack(results[kMean + k], gg.mean[k]);
+    for (int k = 0; k < 4; ++k) cpu::store_pack(results[kQuatOut + k], gg.quat[k]);
+    cpu::store_pack(results[kScaleU], gg.scale_u);
+    cpu::store_pack(results[kScaleV], gg.scale_v);
+    cpu::store_pack(results[kOpacity], g.opacity);
+    cpu::store_pack(results[kMean2d], g.mean2d.x);
+    cpu::store_pack(results[kMean2d + 1], g.mean2d.y);
     for (int l = 0; l < count; ++l) {
         const std::size_t i = ids[l];
-        for (int k = 0; k < 3; ++k) out.means[3 * i + k] = gg.mean[k][l];
-        for (int k = 0; k < 4; ++k) out.quats[4 * i + k] = gg.quat[k][l];
-        out.scales[2 * i] = gg.scale_u[l];
-        out.scales[2 * i + 1] = gg.scale_v[l];
-        out.opacities[i] = g.opacity[l];
-        out.mean2d[2 * i] = g.mean2d.x[l];
-        out.mean2d[2 * i + 1] = g.mean2d.y[l];
-        for (int c = 0; c < C; ++c) out.colors[i * C + c] = sums[Slot::kColor + c][l];
+        for (int k = 0; k < 3; ++k) out.means[3 * i + k] = results[kMean + k][l];
+        for (int k = 0; k < 4; ++k) out.quats[4 * i + k] = results[kQuatOut + k][l];
+        out.scales[2 * i] = results[kScaleU][l];
+        out.scales[2 * i + 1] = results[kScaleV][l];
+        out.opacities[i] = results[kOpacity][l];
+        out.mean2d[2 * i] = results[kMean2d][l];
+        out.mean2d[2 * i + 1] = results[kMean2d + 1][l];
+        if (C == 3)  // a copy of known length (of a run-time length, a loop per lane)
+            for (int c = 0; c < 3; ++c) out.colors[i * 3 + c] = sums[Slot::kColor + c][l];
+        else
+            for (int c = 0; c < C; ++c) out.colors[i * C + c] = sums[Slot::kColor + c][l];
     }
 }
 
