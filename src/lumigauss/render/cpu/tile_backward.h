@@ -145,10 +145,12 @@ LG_ALWAYS_INLINE void render_tile_backward(int tile, int channels, const RasterS
         // reorder window.) As in the forward, no lane tests the entry's pixel box.
         const auto walked = [&](std::uint32_t j)
                                 LG_LAMBDA_INLINE -> std::uint32_t { return kept[first + length - 1 - j]; };
-        const auto record = [&](std::uint32_t j)
-                                LG_LAMBDA_INLINE -> Unblended& { return records[j % kUnblendChunk]; };
         for (std::uint32_t chunk = 0; chunk < length; chunk += kUnblendChunk) {
             const std::uint32_t chunk_end = std::min(length, chunk + kUnblendChunk);
+            // Entry j's record. (As j % kUnblendChunk, the same place, its address was recomputed in every
+            // iteration of every loop; as an offset from the chunk's start it is a pointer stepped along.)
+            const auto record = [&](std::uint32_t j)
+                                    LG_LAMBDA_INLINE -> Unblended& { return records[j - chunk]; };
             for (std::uint32_t j = chunk; j < chunk_end; ++j) {
                 if (j + kPrefetchAhead < length)
                     prefetch_entry(st, begin + walked(j + kPrefetchAhead), channels);
