@@ -120,8 +120,9 @@ template <typename L, int C>
 LG_HD_INLINE BlendSampleGrad<L> unblend_sample(BlendPixelBackward<L, C>& s, L a, const SampleValues<L>& v,
                                                LaneIndex<L> entry) {
     const L one_minus_a = L(1) - a;
-    // One division for both quotients: the walk's loop had three (this, the background term's and the
-    // distortion's 1 / z), which kept the divider busier than the rest of the loop.
+    // One division for both quotients: the CPU walk's loop had three per entry (this, the background
+    // term's and the distortion's 1 / z) against some 65 other instructions, and each holds the divider for
+    // several cycles.
     const L inv_one_minus_a = L(1) / one_minus_a;
     const L t_before = s.trans * inv_one_minus_a;
     const L w = a * t_before;
