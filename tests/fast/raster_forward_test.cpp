@@ -303,14 +303,6 @@ TEST(RasterProjection, IntersectionReprojectsToThePixel) {
     }
 }
 
-// The kernel's geometry as the float CPU backend stores it: set up in double, each value rounded.
-raster::SplatGeometry<float> rounded_to_float(const raster::SplatGeometry<double>& g) {
-    const auto vec3 = [](Vec3<double> v) { return v.cast<float>(); };
-    return {
-        vec3(g.pa),       vec3(g.pb),         vec3(g.pd), vec3(g.tw), {float(g.center.x), float(g.center.y)},
-        float(g.opacity), float(g.rho_cutoff)};
-}
-
 TEST(RasterProjection, BoundingBoxHoldsEveryContributingPixel) {
     // Brute force: every pixel where the kernel says the surfel contributes lies inside its box, for
     // random surfels of every opacity, including ones whose box is clipped by the image border. The tile
@@ -328,7 +320,10 @@ TEST(RasterProjection, BoundingBoxHoldsEveryContributingPixel) {
         raster::ProjectedSurfel<double> p;
         if (!raster::project_surfel(s.geometry(i), s.opacities[i], view, p)) continue;
         const auto g = raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, s.opacities[i]);
-        const auto gf = rounded_to_float(g);
+        raster::ProjectionVjpInputs<float> pf;
+        raster::SplatGeometry<float> gf;  // as the backends store it
+        SplatFootprint<float> ff;
+        store_projected(p, s.opacities[i], pf, gf, ff);
         for (int y = 0; y < cam.height; ++y)
             for (int x = 0; x < cam.width; ++x) {
                 const bool inside = x >= p.rect.x0 && x <= p.rect.x1 && y >= p.rect.y0 && y <= p.rect.y1;

@@ -95,6 +95,22 @@ struct SplatFootprint {
     T depth;
 };
 
+// What every backend stores of one projected surfel (`p` from project_surfel, in double), rounded to T: the
+// state the projection's backward reads, the per-pixel kernel's geometry, and the footprint. (Written into
+// the destinations: returned as one structure, the CPU projection copied it through the stack.)
+template <typename T>
+LG_HD inline void store_projected(const raster::ProjectedSurfel<double>& p, double opacity,
+                                  raster::ProjectionVjpInputs<T>& projection, raster::SplatGeometry<T>& splat,
+                                  SplatFootprint<T>& footprint) {
+    const raster::SplatGeometry<double> g =
+        raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, opacity, p.reach);
+    const Vec2<T> center{T(p.center.x), T(p.center.y)};
+    projection = {p.tu.cast<T>(), p.tv.cast<T>(), p.tw.cast<T>(), center, T(p.flip), p.conic_center};
+    splat = {g.pa.cast<T>(), g.pb.cast<T>(), g.pd.cast<T>(), g.tw.cast<T>(),
+             center,         T(g.opacity),   T(g.rho_cutoff)};
+    footprint = {p.rect, p.normal.cast<T>(), T(p.depth)};
+}
+
 // Tiles a surfel's box touches (inclusive).
 struct TileSpan {
     int tx0, ty0, tx1, ty1;

@@ -21,24 +21,12 @@ namespace {
 
 using raster::ProjectedSurfel;
 
-template <typename T>
-Vec3<T> to(Vec3<double> v) {
-    return v.cast<T>();
-}
-
-// Stores one projected surfel: the projection state the backward reads, what the per-pixel kernel reads,
-// and the footprint binning reads. Returns false (and stores nothing) when it reaches no pixel.
+// Stores one projected surfel (store_projected). Returns false (and stores nothing) when it reaches no pixel.
 template <typename T>
 LG_ALWAYS_INLINE bool store_projection(const ProjectedSurfel<double>& p, double opacity, RasterState<T>& st,
                                        std::size_t i) {
     if (p.rect.empty()) return false;
-    const auto sg = raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, opacity, p.reach);
-    st.projections[i] = {to<T>(p.tu), to<T>(p.tv),   to<T>(p.tw), {T(p.center.x), T(p.center.y)},
-                         T(p.flip),   p.conic_center};
-    st.splats[i] = {
-        to<T>(sg.pa),  to<T>(sg.pb),    to<T>(sg.pd), to<T>(sg.tw), {T(sg.center.x), T(sg.center.y)},
-        T(sg.opacity), T(sg.rho_cutoff)};
-    st.footprints[i] = {p.rect, to<T>(p.normal), T(p.depth)};
+    store_projected(p, opacity, st.projections[i], st.splats[i], st.footprints[i]);
     return true;
 }
 

@@ -15,13 +15,8 @@ unsigned blocks_for(std::size_t n) {
     return unsigned((n + kThreads - 1) / kThreads);
 }
 
-template <typename T>
-__device__ Vec3<float> to_float(Vec3<T> v) {
-    return {float(v.x), float(v.y), float(v.z)};
-}
-
 // One thread per surfel: the CPU backend's projection (project_surfel in double; what it stores, rounded
-// to float), and the number of tiles its pixel box touches (0: not visible).
+// to float by the same store_projected), and the number of tiles its pixel box touches (0: not visible).
 __global__ void project_kernel(std::size_t n, const float* __restrict__ means,
                                const float* __restrict__ quats, const float* __restrict__ scales,
                                const float* __restrict__ opacities, raster::PinholeView<double> view,
@@ -41,17 +36,7 @@ __global__ void project_kernel(std::size_t n, const float* __restrict__ means,
         tiles_touched[i] = 0;
         return;
     }
-    const auto sg = raster::make_splat_geometry(p.tu, p.tv, p.tw, p.center, opacity, p.reach);
-    projections[i] = {to_float(p.tu), to_float(p.tv), to_float(p.tw), {float(p.center.x), float(p.center.y)},
-                      float(p.flip),  p.conic_center};
-    splats[i] = {to_float(sg.pa),
-                 to_float(sg.pb),
-                 to_float(sg.pd),
-                 to_float(sg.tw),
-                 {float(sg.center.x), float(sg.center.y)},
-                 float(sg.opacity),
-                 float(sg.rho_cutoff)};
-    footprints[i] = {p.rect, to_float(p.normal), float(p.depth)};
+    store_projected(p, opacity, projections[i], splats[i], footprints[i]);
     tiles_touched[i] = tile_span(p.rect).count();
 }
 
