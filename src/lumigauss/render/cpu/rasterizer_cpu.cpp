@@ -223,13 +223,15 @@ LG_ALWAYS_INLINE void write_zero_gradients(SurfelGrads<T>& out, std::size_t i, i
 // (surfel, tile) slots, then converts the sums to the surfel's gradients. Lanes past `count` repeat the
 // last surfel and are not stored. The per-surfel values go through plain arrays, lane by lane, into packs
 // and back (written lane by lane into packs, GCC keeps them in memory halves; see tile_backward.h).
-template <typename T>
+// kChannels is the surfels' channel count where it is known at compile time (RGB), else 0: the slot
+// loops then have a fixed length.
+template <int kChannels, typename T>
 LG_ALWAYS_INLINE void reduce_lanes(const SurfelBatch<T>& surfels, const RasterState<T>& st, const T* slots,
                                    SurfelGrads<T>& out, const std::uint32_t* ids, int count) {
     using P = cpu::Pack8<T>;
     using Slot = cpu::SlotLayout;
     constexpr int N = cpu::kLanes;
-    const int C = surfels.channels;
+    const int C = kChannels > 0 ? kChannels : surfels.channels;
     const int stride = Slot::stride(C);  // a multiple of the pack width
     const int line = Slot::line_stride(C);
     alignas(64) T sums[Slot::stride(kMaxChannels)][N];
@@ -240,9 +242,14 @@ LG_ALWAYS_INLINE void reduce_lanes(const SurfelBatch<T>& surfels, const RasterSt
     alignas(64) typename cpu::Int8<T>::I conic[N];
     for (int l = 0; l < N; ++l) {
         const std::uint32_t i = ids[std::min(l, count - 1)];
-        T* const sum = lane_sums[l];  // cleared by packs (`= {}` became a `rep stos`)
-        for (int k = 0; k < stride; k += N) cpu::store_pack(sum + k, P(T(0)));
-        for (std::uint32_t em = st.emission_offset[i]; em < st.emission_offset[i + 1]; ++em) {
+        // The sum starts from the first slot: a visible surfel has one in every tile it reaches, so at
+        // least one. (Cleared first instead, by packs or `= {}`, the sum was a call to memset per surfel.)
+        T* const sum = lane_sums[l];
+        const std::uint32_t first = st.emission_offset[i], end = st.emission_offset[i + 1];
+        if (first == end) throw Error("rasterizer backward: a visible surfel reaches no tile");
+        for (int k = 0; k < stride; k += N)
+            cpu::store_pack(sum + k, cpu::load_pack(&slots[std::size_t(first) * line + k]));
+        for (std::uint32_t em = first + 1; em < end; ++em) {
             const T* slot = &slots[std::size_t(em) * line];
             for (int k = 0; k < stride; k += N)
                 cpu::store_pack(sum + k, cpu::load_pack(sum + k) + cpu::load_pack(slot + k));
@@ -332,8 +339,11 @@ LG_ALWAYS_INLINE void reduce_range(const SurfelBatch<T>& surfels, const RasterSt
                 __builtin_prefetch(slot);
                 __builtin_prefetch(slot + summed - 1);
             }
-            reduce_lanes(surfels, st, slots, out, &visible[first],
-                         std::min(cpu::kLanes, num_visible - first));
+            const int lanes = std::min(cpu::kLanes, num_visible - first);
+            if (surfels.channels == 3)
+                reduce_lanes<3>(surfels, st, slots, out, &visible[first], lanes);
+            else
+                reduce_lanes<0>(surfels, st, slots, out, &visible[first], lanes);
         }
     }
 }
