@@ -133,6 +133,31 @@ TEST(RasterForward, InconsistentBatchIsAnErrorNamingTheArray) {
     EXPECT_THROW(rasterize_backward_cpu(s, st, g, grads), Error);  // not the forward's surfels
 }
 
+// The reduction starts each visible surfel's sum from its first (surfel, tile) slot. A state in which a
+// visible surfel has none (here made by hand: the forward never leaves one) is reported, not read past.
+TEST(RasterForward, BackwardOfAStateWithAVisibleSurfelWithoutSlotsIsAnError) {
+    const Camera cam = test_camera();
+    const SurfelBatch<float> s = convert_batch<float>(random_surfels<double>(cam, 11));
+    RasterState<float> st;
+    RasterImages<float> img;
+    rasterize_forward_cpu(cam, s, RasterSettings<float>{}, st, img);
+    std::size_t i = 0;
+    while (i < s.size() && !st.visible[i]) ++i;
+    ASSERT_LT(i, s.size()) << "no visible surfel";
+    ASSERT_LT(st.emission_offset[i], st.emission_offset[i + 1]);
+    RasterImageGrads<float> g;
+    g.color.assign(img.color.size(), 0.01f);
+    SurfelGrads<float> grads;
+    rasterize_backward_cpu(s, st, g, grads);  // consistent: no error
+    st.emission_offset[i + 1] = st.emission_offset[i];
+    try {
+        rasterize_backward_cpu(s, st, g, grads);
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("reaches no tile"), std::string::npos) << e.what();
+    }
+}
+
 TEST(RasterForward, EmptySceneIsBackground) {
     const Camera cam = test_camera();
     SurfelBatch<float> s;
