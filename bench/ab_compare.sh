@@ -7,14 +7,10 @@
 #   bench/ab_compare.sh OLD_BINARY NEW_BINARY [FILTER] [ROUNDS, default 8] [MIN_TIME s, default 0.6]
 #   bench/ab_compare.sh /tmp/raster_bench_old build/bench/raster_bench '^BM_Backward/w:320/h:240/surfels:200000'
 set -euo pipefail
-if [ $# -lt 2 ]; then
-    sed -n '2,8p' "$0" >&2
-    exit 2
-fi
+source "$(dirname "$0")/script_args.sh"
+usage_unless $# 2
 old="$1"; new="$2"; filter="${3:-.}"; rounds="${4:-8}"; min_time="${5:-0.6}"
-for bin in "$old" "$new"; do
-    [ -x "$bin" ] || { echo "ab_compare.sh: $bin is not an executable" >&2; exit 2; }
-done
+require_executables "$old" "$new"
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 for round in $(seq "$rounds"); do

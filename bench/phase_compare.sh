@@ -7,14 +7,10 @@
 #   bench/phase_compare.sh FILTER ROUNDS BINARY...
 #   bench/phase_compare.sh '^BM_ForwardBackward/w:320/h:240/surfels:200000' 6 /tmp/raster_bench_old build/bench/raster_bench
 set -euo pipefail
-if [ $# -lt 3 ]; then
-    sed -n '2,8p' "$0" >&2
-    exit 2
-fi
+source "$(dirname "$0")/script_args.sh"
+usage_unless $# 3
 filter="$1"; rounds="$2"; shift 2
-for bin in "$@"; do
-    [ -x "$bin" ] || { echo "phase_compare.sh: $bin is not an executable" >&2; exit 2; }
-done
+require_executables "$@"
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 for round in $(seq "$rounds"); do

@@ -7,14 +7,10 @@
 #   bench/poll_target.sh CYCLES PAUSE BINARY...
 #   bench/poll_target.sh 60 45 build/bench/raster_bench /tmp/raster_bench_old | tee poll.log
 set -euo pipefail
-if [ $# -lt 3 ]; then
-    sed -n '2,8p' "$0" >&2
-    exit 2
-fi
+source "$(dirname "$0")/script_args.sh"
+usage_unless $# 3
 cycles="$1"; pause="$2"; shift 2
-for bin in "$@"; do
-    [ -x "$bin" ] || { echo "poll_target.sh: $bin is not an executable" >&2; exit 2; }
-done
+require_executables "$@"
 filter='^BM_ForwardBackward/w:320/h:240/surfels:200000/threads:2'
 binaries=("$@")
 for cycle in $(seq "$cycles"); do
