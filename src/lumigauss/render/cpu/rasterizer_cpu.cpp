@@ -301,10 +301,7 @@ LG_ALWAYS_INLINE void reduce_lanes(const SurfelBatch<T>& surfels, const RasterSt
         out.opacities[i] = results[kOpacity][l];
         out.mean2d[2 * i] = results[kMean2d][l];
         out.mean2d[2 * i + 1] = results[kMean2d + 1][l];
-        if (C == 3)  // a copy of known length (of a run-time length, a loop per lane)
-            for (int c = 0; c < 3; ++c) out.colors[i * 3 + c] = sums[Slot::kColor + c][l];
-        else
-            for (int c = 0; c < C; ++c) out.colors[i * C + c] = sums[Slot::kColor + c][l];
+        for (int c = 0; c < C; ++c) out.colors[i * C + c] = sums[Slot::kColor + c][l];  // known C for RGB
     }
 }
 
