@@ -6,6 +6,7 @@
 
 #include "lumigauss/math/quaternion.h"
 #include "lumigauss/scene/knn.h"
+#include "lumigauss/scene/point_normals.h"
 #include "lumigauss/shading/sh.h"
 #include "lumigauss/synth/rng.h"
 #include "lumigauss/util/error.h"
@@ -45,7 +46,7 @@ const char* GaussianModel::name(ModelParam p) {
 
 GaussianModel GaussianModel::from_points(const std::vector<Vec3f>& xyz, const std::vector<Vec3f>& rgb,
                                          double spatial_lr_scale, std::uint64_t seed,
-                                         const ModelLearningRates& lr) {
+                                         const ModelLearningRates& lr, bool orient_from_points) {
     if (xyz.size() != rgb.size()) throw Error("GaussianModel: point and colour counts differ");
     const std::size_t n = xyz.size();
     std::vector<std::vector<float>> raw(kModelParamCount);
@@ -54,10 +55,15 @@ GaussianModel GaussianModel::from_points(const std::vector<Vec3f>& xyz, const st
     const std::vector<double> dist2 = mean_sq_dist_knn(xyz, 3);
     synth::Rng rot_rng(synth::hash_keys(seed, kRotationStream));
     const float opacity = inverse_sigmoid(0.1f);
+    const std::vector<Vec3f> normals = orient_from_points ? point_normals(xyz) : std::vector<Vec3f>{};
     for (std::size_t i = 0; i < n; ++i) {
         for (int a = 0; a < 3; ++a) raw[0].push_back(xyz[i][a]);
         // torch.rand((N, 4)): uniform [0, 1)^4, normalised where used.
         for (int a = 0; a < 4; ++a) raw[1].push_back(float(rot_rng.uniform()));
+        if (orient_from_points) {
+            const Vec4<double> q = quaternion_with_normal(normals[i].cast<double>());
+            for (int a = 0; a < 4; ++a) raw[1][raw[1].size() - 4 + std::size_t(a)] = float(q[a]);
+        }
         const float d2 = std::max(float(dist2[i]), 1e-7f);
         const float log_scale = std::log(std::sqrt(d2));
         raw[2].push_back(log_scale), raw[2].push_back(log_scale);
@@ -183,16 +189,18 @@ void GaussianModel::reset_stats() {
 
 void GaussianModel::add_densification_stats(std::span<const float> mean2d_grad,
                                             std::span<const std::uint8_t> visible,
-                                            std::span<const float> radii, int image_width, int image_height) {
+                                            std::span<const float> radii, int image_width, int image_height,
+                                            std::span<const float> damping) {
     const std::size_t n = size();
-    if (mean2d_grad.size() != 2 * n || visible.size() != n || radii.size() != n)
+    if (mean2d_grad.size() != 2 * n || visible.size() != n || radii.size() != n ||
+        (!damping.empty() && damping.size() != n))
         throw Error("add_densification_stats: sizes differ from the model");
     // Pixel x = (ndc_x + 1) W / 2 - 0.5, so dL/d(ndc_x) = dL/dx * W / 2 (2dgs_rasterizer.md 4.2).
     const float hw = 0.5f * float(image_width), hh = 0.5f * float(image_height);
     for (std::size_t i = 0; i < n; ++i) {
         if (!visible[i]) continue;
         const float gx = mean2d_grad[2 * i] * hw, gy = mean2d_grad[2 * i + 1] * hh;
-        grad_accum_[i] += std::sqrt(gx * gx + gy * gy);
+        grad_accum_[i] += std::sqrt(gx * gx + gy * gy) * (damping.empty() ? 1.0f : damping[i]);
         grad_count_[i] += 1.0f;
         max_radii_[i] = std::max(max_radii_[i], radii[i]);
     }
@@ -321,6 +329,19 @@ DensifyReport GaussianModel::densify_and_prune(double grad_threshold, double min
     }
     keep_rows(keep);
     return report;
+}
+
+std::size_t GaussianModel::prune(double min_opacity, double max_world_scale) {
+    const auto& s = param(ModelParam::Scaling);
+    const auto& o = param(ModelParam::Opacity);
+    std::vector<std::uint8_t> keep(size(), 1);
+    std::size_t removed = 0;
+    for (std::size_t i = 0; i < size(); ++i) {
+        const bool too_big = max_world_scale > 0 && max_scale(s, i) > max_world_scale;
+        if (sigmoid(o[i]) < min_opacity || too_big) keep[i] = 0, ++removed;
+    }
+    if (removed > 0) keep_rows(keep);
+    return removed;
 }
 
 void GaussianModel::reset_opacity() {

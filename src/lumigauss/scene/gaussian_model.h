@@ -65,10 +65,12 @@ class GaussianModel {
 
     GaussianModel() = default;
 
-    // create_from_pcd + training_setup. point_rgb in [0, 1]. spatial_lr_scale = cameras_extent.
+    // create_from_pcd + training_setup. point_rgb in [0, 1]. spatial_lr_scale = cameras_extent. Rotations
+    // are random as officially, or with `orient_from_points` turned so that each surfel's normal is the
+    // normal of its point's neighbourhood (scene/point_normals.h).
     static GaussianModel from_points(const std::vector<Vec3f>& xyz, const std::vector<Vec3f>& rgb,
                                      double spatial_lr_scale, std::uint64_t seed,
-                                     const ModelLearningRates& lr = {});
+                                     const ModelLearningRates& lr = {}, bool orient_from_points = false);
     // Wraps existing raw parameters (e.g. a loaded PLY) with fresh optimizer state. Every vector must hold
     // size * width(p) floats.
     static GaussianModel from_raw(std::vector<std::vector<float>> raw, double spatial_lr_scale,
@@ -109,8 +111,10 @@ class GaussianModel {
     // Densification statistics (add_densification_stats plus the max_radii2D update of train.py), for one
     // rendered view: for each visible surfel, accum += |(g_x W/2, g_y H/2)| (mean2d in pixels -> NDC units),
     // count += 1, max_radius = max(max_radius, radius).
+    // `damping` (empty, or one factor per surfel) scales each gradient norm before it is accumulated.
     void add_densification_stats(std::span<const float> mean2d_grad, std::span<const std::uint8_t> visible,
-                                 std::span<const float> radii, int image_width, int image_height);
+                                 std::span<const float> radii, int image_width, int image_height,
+                                 std::span<const float> damping = {});
     const std::vector<float>& grad_accum() const { return grad_accum_; }
     const std::vector<float>& grad_count() const { return grad_count_; }
     const std::vector<float>& max_radii() const { return max_radii_; }
@@ -123,6 +127,9 @@ class GaussianModel {
     DensifyReport densify_and_prune(double grad_threshold, double min_opacity, double extent,
                                     double max_screen_size, std::uint64_t seed,
                                     const DensifyOptions& opt = {});
+    // The prune alone, for the iterations after densification: removes surfels with opacity < min_opacity or
+    // (max_world_scale > 0) a scale above max_world_scale. Returns how many were removed.
+    std::size_t prune(double min_opacity, double max_world_scale);
     // opacity <- min(opacity, 0.01) (as logit), opacity moments zeroed (replace_tensor_to_optimizer).
     void reset_opacity();
     // Keeps rows with keep[i] != 0 in every parameter, gradient, Adam state and statistic.

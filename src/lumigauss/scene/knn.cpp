@@ -75,15 +75,20 @@ Grid build_grid(const std::vector<Vec3f>& points) {
     return g;
 }
 
-// Keeps the k smallest squared distances seen, ascending.
+// Keeps the k nearest points seen (squared distance and index), ascending.
 struct Best {
-    std::array<double, 8> d{};
+    static constexpr int kCapacity = 16;
+    std::array<double, kCapacity> d{};
+    std::array<std::uint32_t, kCapacity> index{};
     int k = 0, n = 0;
-    void push(double v) {
+    void push(double v, std::uint32_t j) {
         if (n == k && v >= d[std::size_t(k - 1)]) return;
-        int j = n < k ? n++ : k - 1;
-        while (j > 0 && d[std::size_t(j - 1)] > v) d[std::size_t(j)] = d[std::size_t(j - 1)], --j;
-        d[std::size_t(j)] = v;
+        int i = n < k ? n++ : k - 1;
+        while (i > 0 && d[std::size_t(i - 1)] > v) {
+            d[std::size_t(i)] = d[std::size_t(i - 1)], index[std::size_t(i)] = index[std::size_t(i - 1)];
+            --i;
+        }
+        d[std::size_t(i)] = v, index[std::size_t(i)] = j;
     }
     double worst() const { return n < k ? std::numeric_limits<double>::infinity() : d[std::size_t(k - 1)]; }
 };
@@ -96,7 +101,7 @@ void visit_cell(const Grid& g, const std::vector<Vec3f>& pts, std::size_t self, 
         const std::uint32_t j = g.order[e];
         if (j == self) continue;
         const double dx = double(pts[j].x) - p.x, dy = double(pts[j].y) - p.y, dz = double(pts[j].z) - p.z;
-        best.push(dx * dx + dy * dy + dz * dz);
+        best.push(dx * dx + dy * dy + dz * dz, j);
     }
 }
 
@@ -118,12 +123,9 @@ void visit_shell(const Grid& g, const std::vector<Vec3f>& pts, std::size_t self,
         }
 }
 
-}  // namespace
-
-std::vector<double> mean_sq_dist_knn(const std::vector<Vec3f>& points, int k) {
-    k = std::clamp(k, 1, 8);
-    std::vector<double> out(points.size(), 0.0);
-    if (points.size() < 2) return out;
+// The k nearest other points of every point, by growing shells of cells around its own.
+template <typename F>
+void for_each_knn(const std::vector<Vec3f>& points, int k, F&& f) {
     const Grid g = build_grid(points);
     const int max_ring = std::max({g.dims[0], g.dims[1], g.dims[2]});
     for (std::size_t i = 0; i < points.size(); ++i) {
@@ -138,10 +140,33 @@ std::vector<double> mean_sq_dist_knn(const std::vector<Vec3f>& points, int k) {
             const double bound = double(r) * g.cell;
             if (best.n == best.k && best.worst() <= bound * bound) break;
         }
+        f(i, best);
+    }
+}
+
+}  // namespace
+
+std::vector<double> mean_sq_dist_knn(const std::vector<Vec3f>& points, int k) {
+    k = std::clamp(k, 1, 8);
+    std::vector<double> out(points.size(), 0.0);
+    if (points.size() < 2) return out;
+    for_each_knn(points, k, [&](std::size_t i, const Best& best) {
         double sum = 0;
         for (int j = 0; j < best.n; ++j) sum += best.d[std::size_t(j)];
         out[i] = best.n > 0 ? sum / best.n : 0.0;
-    }
+    });
+    return out;
+}
+
+std::vector<std::uint32_t> knn_indices(const std::vector<Vec3f>& points, int k) {
+    k = std::clamp(k, 1, Best::kCapacity);
+    std::vector<std::uint32_t> out(points.size() * std::size_t(k));
+    if (points.empty()) return out;
+    for_each_knn(points, k, [&](std::size_t i, const Best& best) {
+        for (int j = 0; j < k; ++j)  // fewer than k others: repeat the point itself
+            out[i * std::size_t(k) + std::size_t(j)] =
+                j < best.n ? best.index[std::size_t(j)] : std::uint32_t(i);
+    });
     return out;
 }
 
