@@ -25,11 +25,15 @@ void check_files(const RawView& raw) {
         fail_in_file(v.image_path, "image is " + size_text(image.width, image.height) + " but its camera (" +
                                        raw.camera_origin + ") is " +
                                        size_text(v.camera.width, v.camera.height));
-    if (v.mask_path.empty()) return;
-    const ImageInfo mask = read_image_info(v.mask_path);
-    if (mask.width != image.width || mask.height != image.height)
-        fail_in_file(v.mask_path, "mask is " + size_text(mask.width, mask.height) + " but its image " +
-                                      v.image_path + " is " + size_text(image.width, image.height));
+    for (const auto& [path, kind] :
+         {std::pair{v.mask_path, "mask"}, std::pair{v.sky_mask_path, "sky mask"}}) {
+        if (path.empty()) continue;
+        const ImageInfo mask = read_image_info(path);
+        if (mask.width != image.width || mask.height != image.height)
+            fail_in_file(path, std::string(kind) + " is " + size_text(mask.width, mask.height) +
+                                   " but its image " + v.image_path + " is " +
+                                   size_text(image.width, image.height));
+    }
 }
 
 void check_unique_names(const std::vector<RawView>& views) {
@@ -84,6 +88,15 @@ Image Dataset::load_image(const View& view) const {
 Image Dataset::load_mask(const View& view) const {
     if (view.mask_path.empty()) return Image(view.camera.width, view.camera.height, 1, 1.0f);
     return fit_to_view(to_channels(read_image(view.mask_path), 1), view, view.mask_path, "mask");
+}
+
+Image Dataset::load_sky_mask(const View& view) const {
+    if (view.sky_mask_path.empty()) return Image();
+    return fit_to_view(to_channels(read_image(view.sky_mask_path), 1), view, view.sky_mask_path, "sky mask");
+}
+
+bool Dataset::has_sky_masks() const {
+    return std::any_of(views.begin(), views.end(), [](const View& v) { return !v.sky_mask_path.empty(); });
 }
 
 std::vector<const View*> Dataset::split(Split which) const {

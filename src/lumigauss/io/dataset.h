@@ -3,8 +3,11 @@
 // points. Two layouts are recognised (load_dataset sniffs which):
 //   COLMAP:   <root>/sparse/0/ (or <root>/sparse/) with {cameras,images,points3D}.{bin,txt}, <root>/images/,
 //             optional <root>/masks/ (mask of images/a/b.jpg: masks/a/b.<any image extension> or
-//             masks/a/b.jpg.png, COLMAP's own naming), optional <root>/*split.csv (`filename;split`).
-//   NeRF-OSR: <root>/final/ (or <root> itself) with {train,validation,test}/{rgb,pose,intrinsics,mask}/.
+//             masks/a/b.jpg.png, COLMAP's own naming), optional <root>/sky_masks/ (the same naming; 255 =
+//             the pixel sees the sky, as a semantic segmentation gives it), optional <root>/*split.csv
+//             (`filename;split`).
+//   NeRF-OSR: <root>/final/ (or <root> itself) with {train,validation,test}/{rgb,pose,intrinsics,mask}/ and
+//             optional {train,validation,test}/sky_mask/.
 // Pixels are loaded lazily (load_image, load_mask); load_dataset only checks that every file is there and
 // that its header size matches its camera.
 //
@@ -31,10 +34,11 @@ enum class Split { Train, Test, Validation };
 const char* split_name(Split split);  // "train", "test", "validation"
 
 struct View {
-    std::string name;        // image name as the model gives it (relative to the images folder)
-    std::string image_path;  // full path
-    std::string mask_path;   // empty if the view has no mask
-    Camera camera;           // at the loaded (downscaled) resolution
+    std::string name;           // image name as the model gives it (relative to the images folder)
+    std::string image_path;     // full path
+    std::string mask_path;      // empty if the view has no mask
+    std::string sky_mask_path;  // empty if the view has no sky mask
+    Camera camera;              // at the loaded (downscaled) resolution
     // Where the pinhole came from: the COLMAP model name, or "NERF-OSR K" for NeRF-OSR.
     std::string camera_model;
     Split split = Split::Train;
@@ -54,6 +58,11 @@ struct Dataset {
     // One channel in [0, 1] (first channel of the file; 1 = use the pixel), resized like the image. All ones
     // when the view has no mask. Throws Error naming the mask file if its size differs from the image's.
     Image load_mask(const View& view) const;
+    // One channel in [0, 1], 1 = sky, resized like the image; an empty image when the view has none. Throws
+    // Error naming the file if it cannot be read or its size differs from the image's.
+    Image load_sky_mask(const View& view) const;
+    // True when at least one view has a sky mask.
+    bool has_sky_masks() const;
     std::vector<const View*> split(Split which) const;
 };
 

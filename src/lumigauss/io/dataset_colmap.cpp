@@ -1,4 +1,4 @@
-// The COLMAP layout: sparse/0 (or sparse) + images/ [+ masks/] [+ *split.csv].
+// The COLMAP layout: sparse/0 (or sparse) + images/ [+ masks/] [+ sky_masks/] [+ *split.csv].
 #include <algorithm>
 #include <filesystem>
 
@@ -150,11 +150,13 @@ RawScene load_colmap_layout(const std::string& root, const DatasetOptions& optio
         fail_in_file(files.images_dir,
                      "images folder not found (a COLMAP scene has images/ next to sparse/)");
     const auto masks = index_images_by_stem((fs::path(root) / "masks").string());
+    const auto sky_masks = index_images_by_stem((fs::path(root) / "sky_masks").string());
     RawScene scene;
     scene.format = files.binary ? "colmap-binary" : "colmap-text";
     for (const ColmapImage& im : model.images) {
         RawView r = colmap_view(im, model.cameras.at(im.camera_id), files);  // the reader checked the id
         r.view.mask_path = find_mask(masks, im.name);
+        r.view.sky_mask_path = find_mask(sky_masks, im.name);
         scene.views.push_back(std::move(r));
     }
     assign_splits(scene.views, root, options.holdout_every);

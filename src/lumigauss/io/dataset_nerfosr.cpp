@@ -1,6 +1,7 @@
 // The NeRF-OSR layout (research/nerfosr_protocol_and_data.md section 1):
 //   final/{train,validation,test}/rgb/<stem>.<jpg|JPG|png>, pose/<stem>.txt, intrinsics/<stem>.txt,
-//   [mask/<stem>.png]  (255 = static scene, 0 = transient; the test split may have none).
+//   [mask/<stem>.png]  (255 = static scene, 0 = transient; the test split may have none),
+//   [sky_mask/<stem>.png] (255 = sky; ours, not NeRF-OSR's: e.g. from the published segmentations).
 // pose/<stem>.txt: 16 numbers, a row-major 4x4 camera-to-world matrix with OpenCV camera axes (x right, y
 // down, z forward), written by NeRF-OSR's cvt.py as the inverse of COLMAP's world-to-camera with no axis
 // flip. We assume exactly that: R_w2c = R_c2w^T, t_w2c = -R_c2w^T C (C = last column), no axis change, the
@@ -82,6 +83,7 @@ void set_intrinsics(Camera& cam, const std::vector<double>& k, const std::string
 
 void add_split(const fs::path& split_dir, Split split, RawScene& scene) {
     const auto masks = index_images_by_stem((split_dir / "mask").string());
+    const auto sky_masks = index_images_by_stem((split_dir / "sky_mask").string());
     std::vector<fs::path> images;
     for (const auto& entry : fs::directory_iterator(split_dir / "rgb"))
         if (entry.is_regular_file() && has_image_extension(entry.path().string()))
@@ -96,6 +98,8 @@ void add_split(const fs::path& split_dir, Split split, RawScene& scene) {
         r.view.split = split;
         const auto mask = masks.find(stem);
         if (mask != masks.end()) r.view.mask_path = mask->second;
+        const auto sky_mask = sky_masks.find(stem);
+        if (sky_mask != sky_masks.end()) r.view.sky_mask_path = sky_mask->second;
         const ImageInfo info = read_image_info(r.view.image_path);
         r.view.camera.width = info.width, r.view.camera.height = info.height;
         set_intrinsics(r.view.camera, read_matrix_file(k_path, 16, 9), k_path);
