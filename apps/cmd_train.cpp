@@ -20,7 +20,9 @@
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/io/text_file.h"
+#include "lumigauss/render/background.h"
 #include "lumigauss/render/raster_maps.h"
+#include "lumigauss/shading/sky_image.h"
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/train/checkpoint.h"
 #include "lumigauss/train/run_folder.h"
@@ -36,7 +38,7 @@ extern "C" void on_interrupt(int) {
 }
 
 struct TrainFlags {
-    std::string scene, out, preset = "paper", config_file;
+    std::string scene, out, preset = "default", config_file;
     std::vector<std::string> overrides;
     std::int64_t iterations = 0, stop_after = 0;
     int downscale = 0, threads = 0;
@@ -127,8 +129,17 @@ void write_previews(const std::string& dir, const Trainer& trainer, int count) {
     std::filesystem::create_directories(dir);
     for (int v = 0; v < std::min<int>(count, int(views.size())); ++v) {
         const TrainView& view = views[std::size_t(v)];
-        const RasterImages<float> img = render_with_environment(
-            trainer.state().model, view.camera, trainer.state().lighting.env_sh(v), ShadingMode::Both);
+        const ShCoeffs<float> env = trainer.state().lighting.env_sh(v);
+        RasterImages<float> img =
+            render_with_environment(trainer.state().model, view.camera, env, ShadingMode::Both);
+        if (trainer.state().config.sky_background) {
+            const TrainState& st = trainer.state();
+            const Sh4Coeffs<float> residual =
+                st.sky_residuals.empty() ? Sh4Coeffs<float>{} : st.sky_residuals.get(v);
+            const Image sky = sky_image(view.camera, env, st.sky_residuals.empty() ? nullptr : &residual);
+            for (int first : {kShadowedOffset, kUnshadowedOffset})
+                composite_background<float>(img, sky.pixels, first);
+        }
         const Image shadowed = raster_channels(img, kShadowedOffset, 3);
         const Image unshadowed = raster_channels(img, kUnshadowedOffset, 3);
         const Image* panels[3] = {&view.rgb, &shadowed, &unshadowed};
@@ -224,7 +235,8 @@ int run_train(const TrainFlags& f) {
                 e.what(), (long long)trainer->iteration(), paths.checkpoint.c_str());
             return 3;
         }
-        const bool log_now = r.iteration % config.log_interval == 0 || r.densify_ran || trainer->done();
+        const bool log_now =
+            r.iteration % config.log_interval == 0 || r.densify_ran || r.prune_ran || trainer->done();
         if (log_now) log << step_log_line(r, elapsed()) << '\n' << std::flush;
         progress.update(r, trainer->done());
         if (config.checkpoint_interval > 0 && r.iteration % config.checkpoint_interval == 0 &&
@@ -263,8 +275,9 @@ void register_train(CLI::App& app) {
     cmd->add_option("-o,--output", f->out, "Run folder (model, lighting, config, log, checkpoint)")
         ->required();
     cmd->add_option("--preset", f->preset,
-                    "paper (official schedule, 40k iterations) or fast (3k, small scenes)")
-        ->check(CLI::IsMember({"paper", "fast"}))
+                    "default (40k iterations, sky and floater handling), fast (3k, small scenes), paper (the "
+                    "official LumiGauss, for reproducing it) or paper-fast")
+        ->check(CLI::IsMember(train_preset_names()))
         ->capture_default_str();
     cmd->add_option("--iterations", f->iterations, "Total iterations (overrides the preset)")
         ->check(CLI::PositiveNumber);

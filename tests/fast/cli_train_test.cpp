@@ -45,7 +45,7 @@ const std::string& tiny_scene() {
 // A 60-iteration run through all three stages: stage 1 to 29, stage 2 30..35, stage 3 from 36;
 // densification at 20 and 40 (30 is in stage 2), an opacity reset at 40; a log line every 5 iterations.
 const std::string kSchedule =
-    " --preset fast --iterations 60 --set warmup=30 --set start_shadowed=35 --set densify_from=10"
+    " --preset paper-fast --iterations 60 --set warmup=30 --set start_shadowed=35 --set densify_from=10"
     " --set densify_until=50 --set densify_interval=10 --set opacity_reset_interval=40"
     " --set start_regularization=20 --set lr_position_max_steps=50 --set log_interval=5"
     " --set checkpoint_interval=20 -q";
@@ -98,7 +98,7 @@ TEST(CliTrain, ShortRunWritesEveryRunFile) {
     // config.json: the full config with the overrides.
     const nlohmann::json config = synth_test::read_json(run + "/config.json");
     ASSERT_TRUE(config.is_object());
-    EXPECT_EQ(config["preset"], "fast");
+    EXPECT_EQ(config["preset"], "paper-fast");
     EXPECT_EQ(config["iterations"], 60);
     EXPECT_EQ(config["warmup"], 30);
     EXPECT_EQ(config["start_shadowed"], 35);
@@ -113,7 +113,7 @@ TEST(CliTrain, ShortRunWritesEveryRunFile) {
     TrainConfig parsed = train_preset("paper");
     apply_train_config_json(parsed, synth_test::read_bytes(run + "/config.json"), "config.json");
     EXPECT_EQ(parsed.warmup, 30);
-    EXPECT_EQ(parsed.preset, "fast");
+    EXPECT_EQ(parsed.preset, "paper-fast");
 
     // log.jsonl: one object per logged iteration, every loss key, in order.
     const std::vector<nlohmann::json> log = read_log(run + "/log.jsonl");

@@ -114,6 +114,24 @@ std::vector<MemberChange> every_member() {
         {"max_screen_size", [](TrainConfig& c) { c.max_screen_size = 0.0; }},
         {"percent_dense", [](TrainConfig& c) { c.percent_dense = 0.015; }},
         {"faithful_radii_reset", [](TrainConfig& c) { c.faithful_radii_reset = false; }},
+        {"init_normals_from_points", [](TrainConfig& c) { c.init_normals_from_points = true; }},
+        {"sky_background", [](TrainConfig& c) { c.sky_background = true; }},
+        {"sky_residual", [](TrainConfig& c) { c.sky_residual = true; }},
+        {"lambda_sky_residual", [](TrainConfig& c) { c.lambda_sky_residual = 0.125; }},
+        {"lr_sky_residual", [](TrainConfig& c) { c.lr_sky_residual = 0.03; }},
+        {"lighting_init_radiance", [](TrainConfig& c) { c.lighting_init_radiance = 0.7; }},
+        {"use_sky_masks", [](TrainConfig& c) { c.use_sky_masks = false; }},
+        {"lambda_sky_alpha", [](TrainConfig& c) { c.lambda_sky_alpha = 0.3; }},
+        {"lambda_sky_colour", [](TrainConfig& c) { c.lambda_sky_colour = 0.7; }},
+        {"sky_mask_erosion", [](TrainConfig& c) { c.sky_mask_erosion = 3; }},
+        {"sky_free_regularizers", [](TrainConfig& c) { c.sky_free_regularizers = true; }},
+        {"lambda_background_alpha", [](TrainConfig& c) { c.lambda_background_alpha = 0.2; }},
+        {"background_match_tolerance", [](TrainConfig& c) { c.background_match_tolerance = 0.05; }},
+        {"background_alpha_from", [](TrainConfig& c) { c.background_alpha_from = 7; }},
+        {"mask_mode", [](TrainConfig& c) { c.mask_mode = "object"; }},
+        {"prune_until_end", [](TrainConfig& c) { c.prune_until_end = true; }},
+        {"densify_near_fraction", [](TrainConfig& c) { c.densify_near_fraction = 0.37; }},
+        {"lambda_opacity", [](TrainConfig& c) { c.lambda_opacity = 0.01; }},
         {"checkpoint_interval", [](TrainConfig& c) { c.checkpoint_interval = 0; }},
         {"log_interval", [](TrainConfig& c) { c.log_interval = 1; }},
     };
@@ -170,9 +188,9 @@ TEST(TrainConfigPreset, PaperHasTheOfficialValues) {
     EXPECT_EQ(c.log_interval, 10);
 }
 
-TEST(TrainConfigPreset, FastShrinksTheScheduleOnly) {
-    const TrainConfig fast = train_preset("fast");
-    EXPECT_EQ(fast.preset, "fast");
+TEST(TrainConfigPreset, PaperFastShrinksTheScheduleOnly) {
+    const TrainConfig fast = train_preset("paper-fast");
+    EXPECT_EQ(fast.preset, "paper-fast");
     EXPECT_EQ(fast.iterations, 3000);
     EXPECT_EQ(fast.warmup, 1500);
     EXPECT_EQ(fast.start_shadowed, 1600);
@@ -197,7 +215,8 @@ TEST(TrainConfigPreset, FastShrinksTheScheduleOnly) {
                                             "densify_until",
                                             "densify_interval",
                                             "opacity_reset_interval",
-                                            "checkpoint_interval"};
+                                            "checkpoint_interval",
+                                            "background_alpha_from"};
     std::set<std::string> differing;
     for (const auto& item : p.items()) {
         if (f.at(item.key()) != item.value()) differing.insert(item.key());
@@ -205,14 +224,39 @@ TEST(TrainConfigPreset, FastShrinksTheScheduleOnly) {
     EXPECT_EQ(differing, expected);
 }
 
-TEST(TrainConfigPreset, BothPresetsValidate) {
-    EXPECT_NO_THROW(validate_train_config(train_preset("paper")));
-    EXPECT_NO_THROW(validate_train_config(train_preset("fast")));
+// The default presets are the paper's (and paper-fast's) plus the improvements of issue #25, each a key.
+TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
+    const std::set<std::string> improvements = {
+        "init_normals_from_points", "sky_background",  "lambda_sky_alpha",     "sky_free_regularizers",
+        "lambda_background_alpha",  "prune_until_end", "densify_near_fraction"};
+    for (const auto& [improved, base] : {std::pair{"default", "paper"}, std::pair{"fast", "paper-fast"}}) {
+        SCOPED_TRACE(improved);
+        const Json a = Json::parse(train_config_to_json(train_preset(improved)));
+        const Json b = Json::parse(train_config_to_json(train_preset(base)));
+        std::set<std::string> differing;
+        for (const auto& item : b.items())
+            if (a.at(item.key()) != item.value()) differing.insert(item.key());
+        std::set<std::string> expected = improvements;
+        expected.insert("preset");
+        EXPECT_EQ(differing, expected);
+        EXPECT_EQ(a.at("preset"), improved);
+    }
+    // The paper preset keeps every improvement off.
+    const TrainConfig paper = train_preset("paper");
+    EXPECT_FALSE(paper.init_normals_from_points || paper.sky_background || paper.prune_until_end);
+    EXPECT_EQ(paper.lambda_sky_alpha, 0.0);
+    EXPECT_EQ(paper.lambda_background_alpha, 0.0);
+}
+
+TEST(TrainConfigPreset, EveryPresetValidates) {
+    for (const std::string& name : train_preset_names())
+        EXPECT_NO_THROW(validate_train_config(train_preset(name)));
 }
 
 TEST(TrainConfigPreset, UnknownNameListsTheValidOnes) {
     const std::string message = error_of([] { (void)train_preset("quick"); });
-    EXPECT_THAT(message, AllOf(HasSubstr("'quick'"), HasSubstr("paper"), HasSubstr("fast")));
+    EXPECT_THAT(message,
+                AllOf(HasSubstr("'quick'"), HasSubstr("default"), HasSubstr("paper"), HasSubstr("fast")));
     EXPECT_THROW((void)train_preset(""), Error);
     EXPECT_THROW((void)train_preset("Paper"), Error);
 }
@@ -225,7 +269,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 41, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 59, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;
@@ -267,7 +311,9 @@ TEST(TrainConfigFields, EveryMemberRoundTripsThroughJsonAndSet) {
         apply_train_config_json(from_key, Json{{m.key, j.at(m.key)}}.dump(), "--config");
         EXPECT_EQ(train_config_to_json(from_key), text);
         TrainConfig from_set;
-        apply_train_config_override(from_set, m.key + "=" + j.at(m.key).dump());
+        const Json& value = j.at(m.key);
+        apply_train_config_override(
+            from_set, m.key + "=" + (value.is_string() ? value.get<std::string>() : value.dump()));
         EXPECT_EQ(train_config_to_json(from_set), text);
     }
 }

@@ -62,7 +62,7 @@ Trainer make_trainer(const TrainConfig& config) {
 // The fast preset with its schedule shrunk so that all three stages and some densification fit in a few
 // hundred iterations.
 TrainConfig shrunk_config() {
-    TrainConfig c = train_preset("fast");
+    TrainConfig c = train_preset("paper-fast");
     c.iterations = 400;
     c.warmup = 200;
     c.start_shadowed = 220;
@@ -113,6 +113,10 @@ void expect_same_state(const TrainState& a, const TrainState& b) {
         EXPECT_TRUE(same_bits(a.lighting.param(MlpGroup(g)), b.lighting.param(MlpGroup(g)))) << name;
         expect_same_adam(a.lighting_adam[std::size_t(g)], b.lighting_adam[std::size_t(g)], name);
     }
+    EXPECT_TRUE(same_bits(a.sky_residuals.params(), b.sky_residuals.params())) << "sky residuals";
+    ASSERT_EQ(a.sky_residual_adam.size(), b.sky_residual_adam.size());
+    for (std::size_t i = 0; i < a.sky_residual_adam.size(); ++i)
+        expect_same_adam(a.sky_residual_adam[i], b.sky_residual_adam[i], "sky residual " + std::to_string(i));
 }
 
 double mean_of(const std::vector<StepReport>& reports, std::size_t first, std::size_t count,
@@ -256,7 +260,7 @@ double pearson(const std::vector<double>& a, const std::vector<double>& b) {
 //     the pooled value is dominated by the up/side contrast of the normals, which even an untrained model
 //     shares by chance; the tiny scene's few surface orientations do not pin down the directional detail)
 TEST(TrainTrainer, LearnedEnvironmentsCorrelateWithTheTrueOnes) {
-    TrainConfig config = train_preset("fast");
+    TrainConfig config = train_preset("paper-fast");
     config.iterations = 600;  // stage 1 only
     config.warmup = 1000;
     config.start_shadowed = 1000;
@@ -311,7 +315,7 @@ TEST(TrainTrainer, LearnedEnvironmentsCorrelateWithTheTrueOnes) {
 // ---- 3. Resume is exact -----------------------------------------------------------------------------------
 
 TEST(TrainTrainer, ResumeFromACheckpointIsBitExact) {
-    TrainConfig config = train_preset("fast");
+    TrainConfig config = train_preset("paper-fast");
     // Second half (61..120): densification at 75 and 100, an opacity reset at 100 (after that densification),
     // stage 2 from 80, stage 3 from 91, regularisation from 66; the last iteration (120) takes no optimizer
     // step. (A reset shortly before a densification would prune every surfel: opacity 0.01 < min_opacity.)
@@ -369,8 +373,40 @@ TEST(TrainTrainer, ResumeFromACheckpointIsBitExact) {
     expect_same_state(straight.state(), resumed.state());
 }
 
-TEST(TrainTrainer, ConstructorsRejectInconsistentInput) {
+// The default presets' state (sky residuals with their per-photo optimizers, the sky losses, the prune after
+// densification) resumes as exactly: the sky colour loss and the residual are switched on to exercise them.
+TEST(TrainTrainer, ResumeIsBitExactWithTheSkyModel) {
     TrainConfig config = train_preset("fast");
+    config.sky_residual = true;
+    config.lambda_sky_colour = 0.5;
+    config.lighting_init_radiance = 0.5;
+    config.iterations = 100;
+    config.warmup = 65, config.start_shadowed = 75;
+    config.densify_from = 10, config.densify_until = 50, config.densify_interval = 20;
+    config.opacity_reset_interval = 40, config.start_regularization = 30, config.background_alpha_from = 10;
+    Trainer straight = make_trainer(config);
+    while (!straight.done()) straight.step();
+
+    TempDir tmp("train_resume_sky");
+    const std::string path = tmp / "half.lgck";
+    {
+        Trainer first = make_trainer(config);
+        while (first.iteration() < 55) first.step();
+        save_checkpoint(path, first.state());
+    }
+    Trainer resumed(tiny_scene().views, load_checkpoint(path));
+    int pruned_alone = 0;
+    while (!resumed.done()) pruned_alone += resumed.step().prune_ran ? 1 : 0;
+    // At 60 and 80: every densify_interval from densify_until on, outside stage 2, not the last iteration.
+    EXPECT_EQ(pruned_alone, 2);
+    expect_same_state(straight.state(), resumed.state());
+    double moved = 0;
+    for (float v : resumed.state().sky_residuals.params()) moved += std::abs(v);
+    EXPECT_GT(moved, 0.0) << "the sky residuals were never trained";
+}
+
+TEST(TrainTrainer, ConstructorsRejectInconsistentInput) {
+    TrainConfig config = train_preset("paper-fast");
     config.iterations = 10;
     const TinyScene& s = tiny_scene();
     const Trainer trainer = make_trainer(config);
@@ -393,7 +429,7 @@ TEST(TrainTrainer, ConstructorsRejectInconsistentInput) {
 // ---- 4. Checkpoint files ----------------------------------------------------------------------------------
 
 TEST(TrainTrainer, CheckpointRoundTripsEveryField) {
-    TrainConfig config = train_preset("fast");
+    TrainConfig config = train_preset("paper-fast");
     config.iterations = 40;
     config.warmup = 25;
     config.start_shadowed = 30;
@@ -422,7 +458,7 @@ TEST(TrainTrainer, CheckpointRoundTripsEveryField) {
 }
 
 TEST(TrainTrainer, DamagedCheckpointsThrowErrorsNamingTheFile) {
-    TrainConfig config = train_preset("fast");
+    TrainConfig config = train_preset("paper-fast");
     config.iterations = 10;
     Trainer trainer = make_trainer(config);
     while (!trainer.done()) trainer.step();
@@ -482,7 +518,7 @@ std::optional<NonFiniteError> non_finite_step(Trainer& trainer) {
 // gets a NaN loss here. Measured: NaN in the green albedo of every surfel trains 195 more iterations without
 // an error (PSNR 11.8 dB, the NaN still in the parameters).
 TEST(TrainTrainer, NanAlbedoThrowsNonFiniteErrorWithoutAdvancing) {
-    TrainConfig config = train_preset("fast");
+    TrainConfig config = train_preset("paper-fast");
     config.iterations = 20;
     Trainer trainer = make_trainer(config);
     for (int i = 0; i < 5; ++i) trainer.step();
@@ -515,7 +551,7 @@ TEST(TrainTrainer, NanAlbedoThrowsNonFiniteErrorWithoutAdvancing) {
 // false); so the loss and all gradients are finite, step() does not throw, and the NaN bias stays in the
 // lighting MLP (195 more iterations ran without an error in a probe).
 TEST(TrainTrainer, NanLightingThrowsNonFiniteErrorWithoutAdvancing) {
-    TrainConfig config = train_preset("fast");
+    TrainConfig config = train_preset("paper-fast");
     config.iterations = 20;
     Trainer trainer = make_trainer(config);
     for (int i = 0; i < 5; ++i) trainer.step();
@@ -531,7 +567,7 @@ TEST(TrainTrainer, NanLightingThrowsNonFiniteErrorWithoutAdvancing) {
 }
 
 TEST(TrainTrainer, NanTransferThrowsNonFiniteErrorInStageTwo) {
-    TrainConfig config = train_preset("fast");
+    TrainConfig config = train_preset("paper-fast");
     config.iterations = 20;
     config.warmup = 4;
     config.start_shadowed = 8;
@@ -577,7 +613,7 @@ TEST(TrainTrainer, StageOfFollowsTheOfficialBoundaries) {
 }
 
 TEST(TrainTrainer, StageOneFreezesTransferAndStageTwoUpdatesOnlyTransfer) {
-    TrainConfig config = train_preset("fast");
+    TrainConfig config = train_preset("paper-fast");
     config.iterations = 60;
     config.warmup = 20;
     config.start_shadowed = 30;
@@ -653,7 +689,7 @@ TEST(TrainTrainer, StageOneFreezesTransferAndStageTwoUpdatesOnlyTransfer) {
 }
 
 TEST(TrainTrainer, ViewOrderVisitsEveryPhotoOncePerEpoch) {
-    TrainConfig config = train_preset("fast");
+    TrainConfig config = train_preset("paper-fast");
     config.iterations = 24;
     Trainer trainer = make_trainer(config);
     const int n = int(trainer.views().size());

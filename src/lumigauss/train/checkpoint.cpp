@@ -11,7 +11,9 @@
 namespace lumigauss {
 namespace {
 
-constexpr char kMagic[9] = "LGCKPT01";
+// Version 2 adds the sky residuals after the lighting model; version 1 files (no residuals) still load.
+constexpr char kMagic[9] = "LGCKPT02";
+constexpr char kMagicV1[9] = "LGCKPT01";
 constexpr char kEndMarker[9] = "LGCKEND1";
 // Sanity bound on any length field, so a corrupt length fails clearly instead of allocating terabytes.
 constexpr std::uint64_t kMaxElements = std::uint64_t(1) << 36;
@@ -126,6 +128,9 @@ void save_checkpoint(const std::string& path, const TrainState& s) {
             w.floats(s.lighting.param(MlpGroup(g)));
             w.adam(s.lighting_adam[std::size_t(g)]);
         }
+        w.floats(s.sky_residuals.params());
+        w.value<std::uint64_t>(s.sky_residual_adam.size());
+        for (const AdamGroup& g : s.sky_residual_adam) w.adam(g);
         w.raw(kEndMarker, 8);
         out.flush();
         if (!out) fail_in_file(tmp, "write failed (disk full?)");
@@ -138,7 +143,9 @@ TrainState load_checkpoint(const std::string& path) {
     Reader r(in, path);
     char magic[8];
     r.raw(magic, 8, "magic");
-    if (std::memcmp(magic, kMagic, 8) != 0) fail_in_file(path, "not a LumiGauss checkpoint (wrong magic)");
+    const bool version1 = std::memcmp(magic, kMagicV1, 8) == 0;
+    if (!version1 && std::memcmp(magic, kMagic, 8) != 0)
+        fail_in_file(path, "not a LumiGauss checkpoint (wrong magic)");
 
     TrainState s;
     s.config = TrainConfig{};
@@ -182,6 +189,20 @@ TrainState load_checkpoint(const std::string& path) {
         s.lighting.param(MlpGroup(g)) = std::move(values);
         restore_adam(s.lighting_adam[std::size_t(g)], r.adam(mlp_group_name(MlpGroup(g))), path,
                      mlp_group_name(MlpGroup(g)));
+    }
+    if (!version1) {
+        std::vector<float> residuals = r.floats("sky residuals");
+        const auto groups = r.length("sky residual optimizers");
+        if (!residuals.empty() || groups != 0) {
+            if (residuals.size() != std::size_t(images) * SkyResiduals::kRowWidth ||
+                groups != std::uint64_t(images))
+                fail_in_file(path, "corrupt checkpoint (sky residuals do not match the photo count)");
+            s.sky_residuals = SkyResiduals(images);
+            s.sky_residuals.params() = std::move(residuals);
+            s.sky_residual_adam = sky_residual_optimizer(s.config, images);
+            for (AdamGroup& g : s.sky_residual_adam)
+                restore_adam(g, r.adam("sky residual optimizer"), path, "sky residuals");
+        }
     }
     char end[8];
     r.raw(end, 8, "end marker");

@@ -3,7 +3,8 @@
 // moments and densification statistics, lighting model with its Adam moments, photo names), in one binary
 // file written atomically (temp file + rename), so an interrupted write never replaces a good checkpoint.
 //
-// Layout (little-endian): magic "LGCKPT01"; then length-prefixed fields in the order of save_checkpoint;
+// Layout (little-endian): magic "LGCKPT02" ("LGCKPT01" files, without the sky residuals, still load); then
+// length-prefixed fields in the order of save_checkpoint;
 // then the end marker "LGCKEND1", so a truncated file is recognised.
 #include <string>
 

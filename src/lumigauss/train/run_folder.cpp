@@ -18,7 +18,8 @@ RunPaths run_paths(const std::string& dir) {
             (d / "checkpoint.lgck").string(),
             (d / "model.ply").string(),
             (d / "lighting.lgmlp").string(),
-            (d / "appearance.json").string()};
+            (d / "appearance.json").string(),
+            (d / "sky.lgsky").string()};
 }
 
 void save_run_model(const RunPaths& paths, const TrainState& state) {
@@ -28,6 +29,7 @@ void save_run_model(const RunPaths& paths, const TrainState& state) {
     for (std::size_t i = 0; i < state.image_names.size(); ++i)
         images.push_back({{"name", state.image_names[i]}, {"index", i}});
     write_file_atomically(paths.appearance, nlohmann::json{{"images", images}}.dump(2) + "\n");
+    if (!state.sky_residuals.empty()) save_sky_residuals(paths.sky, state.sky_residuals);
 }
 
 std::vector<std::string> load_appearance(const std::string& path) {
@@ -66,11 +68,18 @@ std::string step_log_line(const StepReport& r, double elapsed_seconds) {
     j["env"] = r.env;
     j["normal"] = r.normal;
     j["distortion"] = r.distortion;
+    j["sky_alpha"] = r.sky_alpha;
+    j["sky_colour"] = r.sky_colour;
+    j["background_alpha"] = r.background_alpha;
+    j["opacity"] = r.opacity;
+    j["sky_residual"] = r.sky_residual;
     j["psnr"] = r.psnr;
     j["surfels"] = r.surfels;
     if (r.densify_ran) {
         j["cloned"] = r.densified.cloned;
         j["split"] = r.densified.split;
+        j["pruned"] = r.densified.pruned;
+    } else if (r.prune_ran) {
         j["pruned"] = r.densified.pruned;
     }
     if (r.opacity_reset) j["opacity_reset"] = true;

@@ -6,6 +6,7 @@
 //   model.ply         the surfels, official LumiGauss relightable PLY layout (relightable_ply.h)
 //   lighting.lgmlp    the lighting MLP and embedding table (lighting_mlp.h)
 //   appearance.json   the photo names in embedding-table order: {"images": [{"name": ..., "index": i}]}
+//   sky.lgsky         the per-photo sky residuals (sky_residual.h), when the run trained them
 // Every file is written atomically (temp + rename).
 #include <string>
 #include <vector>
@@ -15,11 +16,11 @@
 namespace lumigauss {
 
 struct RunPaths {
-    std::string dir, config, log, checkpoint, model, lighting, appearance;
+    std::string dir, config, log, checkpoint, model, lighting, appearance, sky;
 };
 RunPaths run_paths(const std::string& dir);
 
-// model.ply, lighting.lgmlp and appearance.json of the state.
+// model.ply, lighting.lgmlp, appearance.json and (when trained) sky.lgsky of the state.
 void save_run_model(const RunPaths& paths, const TrainState& state);
 
 // The photo names of appearance.json, in embedding order. Throws Error naming the file if malformed.

@@ -66,13 +66,53 @@ struct TrainConfig {
     double percent_dense = 0.01;
     bool faithful_radii_reset = true;  // replicate the official zeroing of max_radii2D before the prune
 
+    // Beyond the paper (issue #25): each switched off here (the paper preset), on in the default presets.
+    // Surfels start in the plane of their SfM neighbourhood instead of randomly turned (point_normals.h).
+    bool init_normals_from_points = false;
+    // The photo's environment is drawn behind the surfels (colour += T_final * sky, shading/sky_colour.h).
+    bool sky_background = false;
+    // Where sky masks exist: alpha pushed to 0 on sky pixels (mean alpha over the sky mask eroded by
+    // sky_mask_erosion pixels), the environment supervised by the sky pixels it must reproduce (L1 plus
+    // 0.1 x (1 - cosine) per pixel, saturated pixels skipped), and the normal/distortion losses kept off the
+    // sky. The sky's own per-photo residual (degree 4, never used for shading; sky_colour.h), its L2 penalty
+    // per iteration (sum of the squared coefficients of the photo drawn) and its learning rate.
+    bool sky_residual = false;
+    double lambda_sky_residual = 0.01;
+    double lr_sky_residual = 0.02;
+    // The lighting network's output starts as this uniform radiance (0: as officially, its random bias only),
+    // so that the sky and the shading see light from the first iteration (a sky below the radiance floor gets
+    // no gradient).
+    double lighting_init_radiance = 0.0;
+    bool use_sky_masks = true;  // false: train as if the scene had none (to measure what they bring)
+    double lambda_sky_alpha = 0.0;
+    double lambda_sky_colour = 0.0;
+    int sky_mask_erosion = 2;
+    bool sky_free_regularizers = false;
+    // Without sky masks: alpha pushed to 0 where the sky background already explains the photo (pixels whose
+    // ray points above the horizon and whose 3x3 neighbourhood differs from the sky by less than the
+    // tolerance, mean absolute difference over RGB), from iteration background_alpha_from on.
+    double lambda_background_alpha = 0.0;
+    double background_match_tolerance = 0.03;
+    std::int64_t background_alpha_from = 500;
+    // "transient": mask 0 = ignore the pixel (transients, as NeRF-OSR); "object": mask 0 = empty space (a
+    // foreground mask of one object), where alpha is pushed to 0 like on the sky (weight lambda_sky_alpha).
+    std::string mask_mode = "transient";
+    // Floater hygiene: pruning (opacity < min_opacity, scale > 0.1 extent) goes on every densify_interval to
+    // the end of training; the densification gradient of surfels nearer than densify_near_fraction x extent
+    // is damped by (depth / (fraction x extent))^2 (Pixel-GS; 0 = off); an L1 penalty on opacity (3DGS-MCMC).
+    bool prune_until_end = false;
+    double densify_near_fraction = 0.0;
+    double lambda_opacity = 0.0;
+
     // Run bookkeeping (not in the official code).
     std::int64_t checkpoint_interval = 1000;  // iterations between checkpoints; 0 = only at the end/interrupt
     std::int64_t log_interval = 10;           // iterations between log lines; every loss term is logged
 };
 
-// The preset's values; throws Error for an unknown name ("paper" or "fast").
+// The preset's values; throws Error for an unknown name (train_preset_names()).
 TrainConfig train_preset(std::string_view name);
+// "default", "fast", "paper", "paper-fast".
+const std::vector<std::string>& train_preset_names();
 
 // All fields as one flat JSON object, keys as the field names above (pretty-printed).
 std::string train_config_to_json(const TrainConfig& config);

@@ -42,11 +42,21 @@ TrainedRun load_trained_run(const std::string& dir) {
         fail_in_file(run.paths.lighting, "has " + std::to_string(run.lighting.num_images()) +
                                              " embeddings but " + run.paths.appearance + " lists " +
                                              std::to_string(run.image_names.size()) + " photos");
+    if (fs::exists(run.paths.sky)) {
+        run.sky_residuals = load_sky_residuals(run.paths.sky);
+        if (run.sky_residuals.num_images() != int(run.image_names.size()))
+            fail_in_file(run.paths.sky, "has sky residuals for " +
+                                            std::to_string(run.sky_residuals.num_images()) + " photos but " +
+                                            run.paths.appearance + " lists " +
+                                            std::to_string(run.image_names.size()));
+    }
     if (fs::exists(run.paths.config)) {
         const nlohmann::json c = nlohmann::json::parse(read_text_file(run.paths.config), nullptr, false);
         if (c.is_discarded()) fail_in_file(run.paths.config, "not valid JSON");
         if (c.is_object() && c.contains("downscale") && c["downscale"].is_number_integer())
             run.downscale = c["downscale"].get<int>();
+        if (c.is_object() && c.contains("sky_background") && c["sky_background"].is_boolean())
+            run.sky_background = c["sky_background"].get<bool>();
     }
     return run;
 }

@@ -9,6 +9,7 @@
 #include "lumigauss/shading/sh.h"
 #include "lumigauss/train/lighting_mlp.h"
 #include "lumigauss/train/run_folder.h"
+#include "lumigauss/train/sky_residual.h"
 
 namespace lumigauss {
 
@@ -19,6 +20,8 @@ struct TrainedRun {
     LightingMlp lighting;
     std::vector<std::string> image_names;  // appearance.json, in embedding order
     int downscale = 0;                     // config.json "downscale"; 0 if unknown
+    bool sky_background = false;           // config.json "sky_background": trained with the sky drawn behind
+    SkyResiduals sky_residuals;            // sky.lgsky when present (per-photo sky residuals)
 
     // Embedding index of the training photo called exactly `name`, or -1.
     int find_image(const std::string& name) const;

@@ -6,11 +6,14 @@
 #include <numeric>
 
 #include "lumigauss/io/scene_extent.h"
+#include "lumigauss/render/background.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/shading/sky_image.h"
 #include "lumigauss/synth/rng.h"
 #include "lumigauss/train/depth_normal.h"
 #include "lumigauss/train/image_losses.h"
 #include "lumigauss/train/physical_losses.h"
+#include "lumigauss/train/sky_losses.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {
@@ -53,7 +56,19 @@ std::vector<AdamGroup> lighting_optimizer(const TrainConfig& c, int num_images) 
     return groups;
 }
 
+std::vector<AdamGroup> sky_residual_optimizer(const TrainConfig& c, int num_images) {
+    std::vector<AdamGroup> groups;
+    for (int i = 0; i < num_images; ++i)
+        groups.emplace_back("sky_residual", std::size_t(SkyResiduals::kRowWidth), c.lr_sky_residual,
+                            SkyResiduals::kRowWidth);
+    return groups;
+}
+
 namespace {
+
+bool uses_sky_residual(const TrainConfig& c) {
+    return c.sky_background && c.sky_residual;
+}
 
 // Deinterleaves channels [first, first + 3) of an image with `channels` values per pixel.
 void extract_rgb(const std::vector<float>& src, int channels, int first, std::vector<float>& dst) {
@@ -102,6 +117,7 @@ std::vector<TrainView> load_train_views(const Dataset& dataset) {
         t.camera = v->camera;
         t.rgb = dataset.load_image(*v);
         t.mask = dataset.load_mask(*v);
+        t.sky = dataset.load_sky_mask(*v);
         out.push_back(std::move(t));
     }
     return out;
@@ -131,14 +147,25 @@ NonFiniteError::NonFiniteError(std::int64_t iteration_, std::string term_)
       iteration(iteration_),
       term(std::move(term_)) {}
 
+// What each photo's losses act on, fixed for the run (from the photo's masks and the config).
+struct Trainer::ViewMasks {
+    std::vector<float> photometric;  // the photometric loss's mask (the photo's mask as loaded)
+    std::vector<float> empty;        // pixels that must stay empty: the eroded sky, or an object's outside
+    std::vector<float> sky;          // pixels whose photo shows the sky (eroded sky mask); empty: no sky mask
+    std::vector<float> regularizer;  // the normal/distortion losses' mask
+};
+
 struct Trainer::Scratch {
     ViewNormals normals;
+    std::vector<Vec3f> rays;  // world ray of every pixel of the view (sky background)
+    SkyPixels sky;            // the sky along every ray: radiance and colour
+    std::vector<float> g_sky, g_sky_radiance, matched;  // their gradients; background-explained pixels
     SurfelBatch<float> batch;
     RasterState<float> raster;
     RasterImages<float> images;
     RasterImageGrads<float> image_grads;
     SurfelGrads<float> surfel_grads;
-    std::vector<float> rendered, grad_rendered, radii, mean2d;
+    std::vector<float> rendered, grad_rendered, radii, mean2d, damping;
     RasterSettings<float> settings;
 };
 
@@ -155,9 +182,20 @@ Trainer::Trainer(std::vector<TrainView> views, const std::vector<Vec3f>& point_x
     state_.scene_extent = camera_extent(cams).radius;
     for (const auto& v : views_) state_.image_names.push_back(v.name);
     state_.model = GaussianModel::from_points(point_xyz, point_rgb, state_.scene_extent, config.seed,
-                                              model_learning_rates(config));
+                                              model_learning_rates(config), config.init_normals_from_points);
     state_.lighting = LightingMlp(int(views_.size()), std::uint32_t(config.seed));
+    if (config.lighting_init_radiance > 0) {
+        // Every photo's environment starts as a uniform radiance: the DC coefficient of each channel.
+        std::vector<float>& bias = state_.lighting.param(MlpGroup::kB3);
+        for (int ch = 0; ch < 3; ++ch)
+            bias[std::size_t(ch * kShCount)] += float(config.lighting_init_radiance / sh_const::kY00);
+    }
     state_.lighting_adam = lighting_optimizer(config, int(views_.size()));
+    if (uses_sky_residual(config)) {
+        state_.sky_residuals = SkyResiduals(int(views_.size()));
+        state_.sky_residual_adam = sky_residual_optimizer(config, int(views_.size()));
+    }
+    prepare_view_masks();
 }
 
 Trainer::Trainer(std::vector<TrainView> views, TrainState state)
@@ -179,6 +217,41 @@ Trainer::Trainer(std::vector<TrainView> views, TrainState state)
         if (!all_finite(state_.lighting.param(MlpGroup(g))))
             throw Error(std::string("the saved run's lighting parameter '") + mlp_group_name(MlpGroup(g)) +
                         "' holds NaN or Inf values");
+    if (uses_sky_residual(state_.config) && state_.sky_residuals.num_images() != int(views_.size()))
+        throw Error("the saved run has sky residuals for " +
+                    std::to_string(state_.sky_residuals.num_images()) + " photos, the dataset has " +
+                    std::to_string(views_.size()) + " training photos");
+    prepare_view_masks();
+}
+
+void Trainer::prepare_view_masks() {
+    const TrainConfig& c = state_.config;
+    const bool object_masks = c.mask_mode == "object";
+    masks_.assign(views_.size(), ViewMasks{});
+    Vec3d up{0, 0, 0};
+    for (std::size_t v = 0; v < views_.size(); ++v) {
+        const TrainView& view = views_[v];
+        ViewMasks& m = masks_[v];
+        const std::size_t pixels = view.mask.pixels.size();
+        m.photometric = view.mask.pixels;
+        m.regularizer = view.mask.pixels;
+        if (!view.sky.pixels.empty() && c.use_sky_masks) {
+            m.sky = eroded_mask(view.sky, c.sky_mask_erosion);
+            if (c.sky_free_regularizers)
+                for (std::size_t p = 0; p < pixels; ++p)
+                    m.regularizer[p] *= 1.0f - std::min(1.0f, view.sky.pixels[p] * 2.0f);
+        }
+        if (object_masks) {
+            // The outside of the object is empty space: no photometric loss there (the mask), alpha -> 0.
+            Image outside = view.mask;
+            for (float& x : outside.pixels) x = 1.0f - x;
+            m.empty = eroded_mask(outside, c.sky_mask_erosion);
+        } else {
+            m.empty = m.sky;
+        }
+        up = up - view.camera.rotation.row(1);  // the camera's -y is its up
+    }
+    if (length(up) > 0) up_ = ((1.0 / length(up)) * up).cast<float>();
 }
 
 Trainer::~Trainer() = default;
@@ -216,10 +289,12 @@ StepReport Trainer::step() {
     report.stage = stage;
     state_.model.zero_grad();
     state_.lighting.zero_grad();
+    state_.sky_residuals.zero_grad();
     lighting_has_grad_ = false;
     set_learning_rates(it);
 
     report.view = view_for_iteration(it);
+    last_view_ = report.view;
     compute_view_normals(state_.model, views_[std::size_t(report.view)].camera, scratch_->normals);
     if (stage != Stage::TransferFitting) render_step(it, stage, report);
     physical_step(it, stage, report);
@@ -251,26 +326,43 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
 
     t0 = Clock::now();
     rasterize_forward_cpu(view.camera, s.batch, s.settings, s.raster, s.images);
+    // The colour sets the losses read: unshadowed RGB alone in stage 1, shadowed and unshadowed in stage 3.
+    std::vector<int> colour_sets = {0};
+    if (stage != Stage::Unshadowed) colour_sets = {kShadowedOffset, kUnshadowedOffset};
+    const bool residual = uses_sky_residual(c);
+    Sh4Coeffs<float> sky_residual{};
+    if (residual) sky_residual = state_.sky_residuals.get(report.view);
+    if (c.sky_background) {
+        s.rays = pixel_ray_directions(view.camera);
+        sky_pixels(s.rays, env, residual ? &sky_residual : nullptr, s.sky);
+        for (int first : colour_sets) composite_background<float>(s.images, s.sky.colour, first);
+    }
     times_.raster_forward += seconds_since(t0);
 
     t0 = Clock::now();
     const int channels = s.batch.channels;
     const ImageShape shape{view.rgb.width, view.rgb.height, 3};
-    std::span<const float> target = view.rgb.pixels, mask = view.mask.pixels;
+    std::span<const float> target = view.rgb.pixels, mask = masks_[std::size_t(report.view)].photometric;
     RasterImageGrads<float>& g = s.image_grads;
     // The buffers keep their capacity from iteration to iteration (assign/clear do not free): no allocation
     // in the loop. Maps without a loss this iteration stay empty, so the backward skips them.
     const bool regularize = it > c.start_regularization;
+    const ViewMasks& masks = masks_[std::size_t(report.view)];
+    const bool empty_pixels = c.lambda_sky_alpha > 0 && !masks.empty.empty();
+    const bool match_background = c.sky_background && c.lambda_background_alpha > 0 && masks.sky.empty() &&
+                                  c.mask_mode != "object" && it >= c.background_alpha_from;
+    const bool alpha_loss = regularize || c.sky_background || empty_pixels || match_background;
     const std::size_t pixels = shape.pixels();
     g.width = shape.width, g.height = shape.height, g.channels = channels;
     g.color.assign(s.images.color.size(), 0.0f);
-    const auto reset = [&](std::vector<float>& map, std::size_t size) {
-        if (regularize)
+    const auto reset = [&](std::vector<float>& map, std::size_t size, bool used) {
+        if (used)
             map.assign(size, 0.0f);
         else
             map.clear();
     };
-    reset(g.alpha, pixels), reset(g.depth, pixels), reset(g.distortion, pixels), reset(g.normal, 3 * pixels);
+    reset(g.alpha, pixels, alpha_loss), reset(g.depth, pixels, regularize);
+    reset(g.distortion, pixels, regularize), reset(g.normal, 3 * pixels, regularize);
     g.median_depth.clear();
     const auto photometric = [&](int first, double weight, double& l1, double& dssim) -> double {
         extract_rgb(s.images.color, channels, first, s.rendered);
@@ -296,12 +388,52 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     }
     report.total += image_total;
     if (regularize) {
+        const std::span<const float> reg_mask = masks.regularizer;
         report.normal =
-            normal_consistency_loss<float>(view.camera, s.images, mask, float(c.lambda_normal), &g);
-        report.distortion = distortion_loss<float>(s.images, mask, float(c.lambda_distortion), &g);
+            normal_consistency_loss<float>(view.camera, s.images, reg_mask, float(c.lambda_normal), &g);
+        report.distortion = distortion_loss<float>(s.images, reg_mask, float(c.lambda_distortion), &g);
         report.total += c.lambda_normal * report.normal + c.lambda_distortion * report.distortion;
     }
+    if (empty_pixels) {
+        report.sky_alpha = alpha_penalty(s.images.alpha, masks.empty, c.lambda_sky_alpha, g.alpha);
+        report.total += c.lambda_sky_alpha * report.sky_alpha;
+    }
+    if (match_background) {
+        s.matched = background_match_mask(target, s.sky.colour, mask, s.rays, up_, shape.width, shape.height,
+                                          c.background_match_tolerance);
+        report.background_alpha =
+            alpha_penalty(s.images.alpha, s.matched, c.lambda_background_alpha, g.alpha);
+        report.total += c.lambda_background_alpha * report.background_alpha;
+    }
+    if (c.sky_background) {
+        s.g_sky.assign(s.sky.colour.size(), 0.0f);
+        s.g_sky_radiance.clear();
+        if (c.lambda_sky_colour > 0 && !masks.sky.empty()) {
+            s.g_sky_radiance.assign(s.sky.radiance.size(), 0.0f);
+            report.sky_colour = sky_colour_loss(s.sky.colour, s.sky.radiance, target, masks.sky,
+                                                c.lambda_sky_colour, s.g_sky, s.g_sky_radiance);
+            report.total += c.lambda_sky_colour * report.sky_colour;
+        }
+        for (int first : colour_sets)
+            composite_background_backward<float>(s.images, s.sky.colour, first, g, s.g_sky);
+    }
     ShCoeffs<float> g_env{};
+    if (c.sky_background) {
+        const SkyGrads sky_grads = sky_pixels_backward(s.rays, s.sky, s.g_sky, s.g_sky_radiance, residual);
+        g_env = sky_grads.env;
+        if (residual) {
+            // L2 penalty: the residual only takes what the lighting cannot hold.
+            Sh4Coeffs<float> g_res = sky_grads.residual;
+            double penalty = 0;
+            for (int k = 0; k < kSh4Count; ++k) {
+                penalty += double(dot(sky_residual.c[k], sky_residual.c[k]));
+                g_res.c[k] += float(2 * c.lambda_sky_residual) * sky_residual.c[k];
+            }
+            report.sky_residual = penalty;
+            report.total += c.lambda_sky_residual * penalty;
+            state_.sky_residuals.add_grad(report.view, g_res);
+        }
+    }
     report.env = env_nonnegativity_loss(env_pass.sh, c.env_samples, c.seed, it, c.lambda_env, g_env);
     report.total += c.lambda_env * report.env;
     times_.losses += seconds_since(t0);
@@ -312,6 +444,16 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     times_.raster_backward += seconds_since(t0);
 
     t0 = Clock::now();
+    if (c.lambda_opacity > 0) {
+        // 3DGS-MCMC: mean opacity, so that a surfel no photo needs fades and is pruned.
+        double sum = 0;
+        for (float o : s.batch.opacities) sum += o;
+        const std::size_t n = s.batch.size();
+        report.opacity = n > 0 ? sum / double(n) : 0.0;
+        report.total += c.lambda_opacity * report.opacity;
+        const float g_each = n > 0 ? float(c.lambda_opacity / double(n)) : 0.0f;
+        for (float& v : s.surfel_grads.opacities) v += g_each;
+    }
     model.accumulate_grads_from_activated(sg);
     const ShCoeffs<float> g_shading = shade_surfels_backward(model, env, mode, s.normals, sg.colors);
     for (int k = 0; k < kShCount; ++k) g_env.c[k] = g_env.c[k] + g_shading.c[k];
@@ -360,7 +502,12 @@ void Trainer::check_finite(std::int64_t it, const StepReport& r) const {
                                                     {"loss l_shadow", r.shadow},
                                                     {"loss l_+ (environment)", r.env},
                                                     {"loss normal consistency", r.normal},
-                                                    {"loss distortion", r.distortion}};
+                                                    {"loss distortion", r.distortion},
+                                                    {"loss sky alpha", r.sky_alpha},
+                                                    {"loss sky colour", r.sky_colour},
+                                                    {"loss background alpha", r.background_alpha},
+                                                    {"loss opacity", r.opacity},
+                                                    {"loss sky residual", r.sky_residual}};
     for (const auto& [name, value] : terms)
         if (!std::isfinite(value)) throw NonFiniteError(it, name);
     for (int p = 0; p < kModelParamCount; ++p)
@@ -375,11 +522,41 @@ void Trainer::densify_step(std::int64_t it, Stage stage, StepReport& report) {
     const TrainConfig& c = state_.config;
     GaussianModel& model = state_.model;
     // Official: only while it < densify_until and outside stage 2.
-    if (it >= c.densify_until || stage == Stage::TransferFitting) return;
+    if (stage == Stage::TransferFitting) return;
+    if (it >= c.densify_until) {
+        // Beyond the paper: the prune goes on (nothing else removes a surfel once densification ends).
+        if (c.prune_until_end && it % c.densify_interval == 0 && it < c.iterations) {
+            const auto t0 = Clock::now();
+            // The last opacity reset left every opacity at 0.01: the opacity rule waits half a reset interval
+            // for the surfels that matter to recover (densification's own prune waits a whole interval).
+            const std::int64_t last_reset =
+                ((c.densify_until - 1) / c.opacity_reset_interval) * c.opacity_reset_interval;
+            const bool opacity_rule = it - last_reset >= c.opacity_reset_interval / 2;
+            report.densified.pruned = model.prune(opacity_rule ? c.min_opacity : 0.0,
+                                                  DensifyOptions{}.world_size_fraction * state_.scene_extent);
+            report.prune_ran = true;
+            model.zero_grad();
+            times_.densify += seconds_since(t0);
+        }
+        return;
+    }
     const auto t0 = Clock::now();
     const TrainView& view = views_[std::size_t(report.view)];
-    model.add_densification_stats(scratch_->mean2d, scratch_->raster.visible, scratch_->radii,
-                                  view.camera.width, view.camera.height);
+    Scratch& s = *scratch_;
+    s.damping.clear();
+    if (c.densify_near_fraction > 0) {
+        // Pixel-GS: a surfel near the camera covers many pixels, and its summed screen gradient would split
+        // it again and again; (depth / near)^2 undoes the growth of its footprint with nearness.
+        const double near = c.densify_near_fraction * state_.scene_extent;
+        s.damping.assign(model.size(), 1.0f);
+        for (std::size_t i = 0; i < model.size(); ++i)
+            if (s.raster.visible[i]) {
+                const double r = double(s.raster.footprints[i].depth) / near;
+                s.damping[i] = float(std::min(1.0, r * r));
+            }
+    }
+    model.add_densification_stats(s.mean2d, s.raster.visible, s.radii, view.camera.width, view.camera.height,
+                                  s.damping);
     if (it > c.densify_from && it % c.densify_interval == 0) {
         const double max_screen = it > c.opacity_reset_interval ? c.max_screen_size : 0.0;
         DensifyOptions opt;
@@ -404,10 +581,17 @@ void Trainer::optimizer_step(std::int64_t it, Stage) {
     if (it >= state_.config.iterations) return;  // official: no step on the last iteration
     const auto t0 = Clock::now();
     state_.model.step(it);
-    if (lighting_has_grad_)
+    if (lighting_has_grad_) {
         for (int g = 0; g < kMlpGroupCount; ++g)
             state_.lighting_adam[std::size_t(g)].step(state_.lighting.param(MlpGroup(g)),
                                                       state_.lighting.grad(MlpGroup(g)));
+        if (!state_.sky_residuals.empty()) {
+            const std::size_t row = std::size_t(last_view_) * SkyResiduals::kRowWidth;
+            state_.sky_residual_adam[std::size_t(last_view_)].step(
+                std::span<float>(state_.sky_residuals.params()).subspan(row, SkyResiduals::kRowWidth),
+                std::span<const float>(state_.sky_residuals.grads()).subspan(row, SkyResiduals::kRowWidth));
+        }
+    }
     times_.optimizer += seconds_since(t0);
 }
 

@@ -18,17 +18,20 @@
 #include "lumigauss/scene/gaussian_model.h"
 #include "lumigauss/train/adam.h"
 #include "lumigauss/train/lighting_mlp.h"
+#include "lumigauss/train/sky_residual.h"
 #include "lumigauss/train/train_config.h"
 #include "lumigauss/train/view_shading.h"
 
 namespace lumigauss {
 
-// A training photo in memory: RGB in [0, 1], its mask (one value per pixel; all ones without a mask file).
+// A training photo in memory: RGB in [0, 1], its mask (one value per pixel; all ones without a mask file)
+// and its sky mask (one value per pixel, 1 = sky; empty without a sky mask file).
 struct TrainView {
     std::string name;
     Camera camera;
     Image rgb;
     Image mask;
+    Image sky;
 };
 
 // The training photos of a dataset (its train split), in dataset (name) order; the position in this list
@@ -49,10 +52,12 @@ struct StepReport {
     double l1_unshadowed = 0, dssim_unshadowed = 0;
     double range01 = 0, consistency = 0, shadow = 0;
     double env = 0, normal = 0, distortion = 0;
+    double sky_alpha = 0, sky_colour = 0, background_alpha = 0, opacity = 0, sky_residual = 0;
     double psnr = 0;  // masked PSNR of the stage's main render (shadowed in stage 3), 0 in stage 2
     std::size_t surfels = 0;
     DensifyReport densified{};
     bool densify_ran = false, opacity_reset = false;
+    bool prune_ran = false;  // the prune alone, after densification (prune_until_end)
 };
 
 // The state that fully determines the rest of a run (what a checkpoint stores).
@@ -64,11 +69,17 @@ struct TrainState {
     GaussianModel model;
     LightingMlp lighting;
     std::vector<AdamGroup> lighting_adam;  // one per MlpGroup
+    SkyResiduals sky_residuals;            // empty unless config.sky_background && config.sky_residual
+    // One optimizer per photo: a photo's residual is stepped only when the photo is drawn, so that its
+    // moments do not keep moving it on the other photos' iterations (a dense Adam did, by ~30 steps per
+    // visit).
+    std::vector<AdamGroup> sky_residual_adam;
 };
 
 // The model's learning rates and the lighting model's optimizer (one Adam group per MlpGroup) of a config.
 ModelLearningRates model_learning_rates(const TrainConfig& config);
 std::vector<AdamGroup> lighting_optimizer(const TrainConfig& config, int num_images);
+std::vector<AdamGroup> sky_residual_optimizer(const TrainConfig& config, int num_images);
 
 class Trainer {
   public:
@@ -101,6 +112,8 @@ class Trainer {
 
   private:
     struct Scratch;
+    struct ViewMasks;
+    void prepare_view_masks();
     void set_learning_rates(std::int64_t iteration);
     void render_step(std::int64_t iteration, Stage stage, StepReport& report);
     void physical_step(std::int64_t iteration, Stage stage, StepReport& report);
@@ -109,10 +122,13 @@ class Trainer {
     void optimizer_step(std::int64_t iteration, Stage stage);
 
     std::vector<TrainView> views_;
+    std::vector<ViewMasks> masks_;  // per view: what the photometric, alpha and regulariser losses act on
+    Vec3f up_{0, 0, 1};             // the cameras' mean up direction (the horizon of background_alpha)
     TrainState state_;
     std::unique_ptr<Scratch> scratch_;
     PhaseTimes times_;
     bool lighting_has_grad_ = false;
+    int last_view_ = 0;  // the photo of the current iteration (its sky residual is stepped)
 };
 
 // Thrown when a loss term or gradient is not finite; `term` names it.

@@ -1,0 +1,71 @@
+#include "lumigauss/train/sky_residual.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+
+#include "lumigauss/io/atomic_file.h"
+#include "lumigauss/util/error.h"
+
+namespace lumigauss {
+namespace {
+
+constexpr char kMagic[8] = {'L', 'G', 'S', 'K', 'Y', 'R', '0', '1'};
+constexpr std::int32_t kMaxImages = 1 << 24;
+
+void read_exact(std::ifstream& in, const std::string& path, void* data, std::size_t bytes) {
+    in.read(static_cast<char*>(data), std::streamsize(bytes));
+    if (!in) fail_in_file(path, "truncated sky residual file");
+}
+
+}  // namespace
+
+SkyResiduals::SkyResiduals(int num_images)
+    : params_(std::size_t(std::max(num_images, 0)) * kRowWidth, 0.0f), grads_(params_.size(), 0.0f) {}
+
+Sh4Coeffs<float> SkyResiduals::get(int image) const {
+    Sh4Coeffs<float> r;
+    const float* row = params_.data() + std::size_t(image) * kRowWidth;
+    for (int k = 0; k < kSh4Count; ++k) r.c[k] = {row[3 * k], row[3 * k + 1], row[3 * k + 2]};
+    return r;
+}
+
+void SkyResiduals::add_grad(int image, const Sh4Coeffs<float>& g) {
+    float* row = grads_.data() + std::size_t(image) * kRowWidth;
+    for (int k = 0; k < kSh4Count; ++k)
+        for (int c = 0; c < 3; ++c) row[3 * k + c] += g.c[k][c];
+}
+
+void SkyResiduals::zero_grad() {
+    std::fill(grads_.begin(), grads_.end(), 0.0f);
+}
+
+void save_sky_residuals(const std::string& path, const SkyResiduals& residuals) {
+    std::string bytes(kMagic, sizeof kMagic);
+    const std::int32_t header[2] = {residuals.num_images(), kSh4Count};
+    bytes.append(reinterpret_cast<const char*>(header), sizeof header);
+    bytes.append(reinterpret_cast<const char*>(residuals.params().data()),
+                 residuals.params().size() * sizeof(float));
+    write_file_atomically(path, bytes);
+}
+
+SkyResiduals load_sky_residuals(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) fail_in_file(path, "cannot open the sky residual file");
+    char magic[sizeof kMagic];
+    read_exact(in, path, magic, sizeof magic);
+    if (std::memcmp(magic, kMagic, sizeof kMagic) != 0)
+        fail_in_file(path, "not a sky residual file (bad magic)");
+    std::int32_t header[2];
+    read_exact(in, path, header, sizeof header);
+    if (header[0] < 0 || header[0] > kMaxImages || header[1] != kSh4Count)
+        fail_in_file(path, "sky residual dimensions are not N photos x 25 coefficients");
+    SkyResiduals r(header[0]);
+    read_exact(in, path, r.params().data(), r.params().size() * sizeof(float));
+    if (in.peek() != std::ifstream::traits_type::eof())
+        fail_in_file(path, "trailing bytes after the sky residuals");
+    return r;
+}
+
+}  // namespace lumigauss
