@@ -6,9 +6,12 @@
 #include <tbb/global_control.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <sstream>
 
 #include "commands.h"
 #include "lumigauss/io/dataset.h"
@@ -28,8 +31,9 @@ struct RenderOptions {
     int downscale = 0;  // 0: 1 for --ply, the run's training resolution for a run
     int threads = 0;
     std::string backend = "cpu";
+    std::string background_text;  // "sky" or "R,G,B"
     std::vector<float> background{0, 0, 0};
-    bool background_given = false, split_given = false;
+    bool background_given = false, sky_background = false, split_given = false;
     bool extra_maps = false;
     // Run mode (relight_job.h).
     std::string run, outputs = "all";
@@ -61,8 +65,9 @@ void run_relight(const RenderOptions& o) {
     job.downscale = o.downscale;
     job.outputs = parse_relit_outputs(o.outputs);
     job.outputs.exr = o.job.outputs.exr;
-    job.outputs.has_background = o.background_given;
+    job.outputs.has_background = o.background_given && !o.sky_background;
     job.outputs.background = {o.background[0], o.background[1], o.background[2]};
+    job.outputs.sky_background = o.sky_background;
     job.video = !o.no_video;
     const auto t0 = std::chrono::steady_clock::now();
     const RelightSummary summary = run_relight_job(job, [&](const std::string& line) {
@@ -73,7 +78,29 @@ void run_relight(const RenderOptions& o) {
                 summary.cameras.size(), o.out.c_str(), s);
 }
 
-void run_render(const RenderOptions& o) {
+// --background: "sky" (a run: the light's own sky) or three numbers R,G,B.
+void parse_background(RenderOptions& o) {
+    if (!o.background_given) return;
+    if (o.background_text == "sky") {
+        if (o.run.empty())
+            throw Error("--background sky is for a run (the sky of its light); --ply takes R,G,B");
+        o.sky_background = true;
+        return;
+    }
+    o.background.clear();
+    std::stringstream in(o.background_text);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        char* end = nullptr;
+        const float v = std::strtof(item.c_str(), &end);
+        if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(v))
+            throw Error("--background: '" + o.background_text + "' is neither sky nor three numbers R,G,B");
+        o.background.push_back(v);
+    }
+}
+
+void run_render(RenderOptions o) {
+    parse_background(o);
     std::unique_ptr<tbb::global_control> threads;
     if (o.threads > 0)
         threads =
@@ -147,10 +174,9 @@ void register_render(CLI::App& app) {
     cmd->add_option("--split", o->split, "--ply: which views: all, train, test, validation")
         ->check(CLI::IsMember({"all", "train", "test", "validation"}))
         ->capture_default_str();
-    cmd->add_option("--background", o->background,
-                    "background colour R,G,B in [0,1] (a run: composited under colour and albedo using "
-                    "alpha; default black)")
-        ->delimiter(',');
+    cmd->add_option("--background", o->background_text,
+                    "sky (a run: the light's own sky behind the surfels, a panorama as it is) or a colour "
+                    "R,G,B in [0,1] (composited under colour and albedo using alpha); default black");
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)");
     cmd->add_option("--backend", o->backend,
                     "--ply: rasterize on the CPU or on the GPU (cuda: builds with the CUDA backend, on a "

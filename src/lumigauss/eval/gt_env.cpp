@@ -14,6 +14,7 @@
 #include "lumigauss/render/raster_maps.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/sh_text.h"
+#include "lumigauss/shading/sky_image.h"
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/train/trained_run.h"
 #include "lumigauss/util/error.h"
@@ -152,6 +153,7 @@ RelightableRun load_relightable_run(const std::string& dir) {
     run.image_names = std::move(trained.image_names);
     for (int i = 0; i < trained.lighting.num_images(); ++i) run.learned_sh.push_back(trained.learned_sh(i));
     run.downscale = trained.downscale;
+    run.sky_background = trained.sky_background;
     return run;
 }
 
@@ -284,8 +286,16 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
         const RasterImages<float>& relit = renderer.render(v->camera, env);
         r.render_ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         GtEnvPanels& p = r.panels;
-        p.shadowed = clamp01(raster_channels(relit, kRelitShadowed, 3));
-        p.unshadowed = clamp01(raster_channels(relit, kRelitUnshadowed, 3));
+        p.shadowed = raster_channels(relit, kRelitShadowed, 3);
+        p.unshadowed = raster_channels(relit, kRelitUnshadowed, 3);
+        if (run.sky_background) {
+            const Image sky = sky_image(v->camera, env);
+            const Image alpha = alpha_image(relit);
+            p.shadowed = over_background_image(p.shadowed, alpha, sky);
+            p.unshadowed = over_background_image(p.unshadowed, alpha, sky);
+        }
+        p.shadowed = clamp01(p.shadowed);
+        p.unshadowed = clamp01(p.unshadowed);
         p.truth = scene.load_image(*v);
 
         // Evaluation mask.
@@ -300,6 +310,16 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
         if (r.mask_pixels == 0)
             fail_in_file(has_gt_mask ? gt_mask_path : v->image_path,
                          "the evaluation mask is empty (no fully covered pixel after the 5x5 erosion)");
+        if (has_gt_mask) {
+            const Image coverage = load_gt_image(gt_mask_path, w, h, 1);
+            std::size_t covered = 0;
+            for (std::size_t q = 0; q < coverage.pixels.size(); ++q) {
+                if (coverage.pixels[q] != 0.0f) continue;
+                ++r.sky_pixels;
+                covered += relit.alpha[q] > 0.5f ? 1 : 0;
+            }
+            r.sky_alpha_fraction = r.sky_pixels > 0 ? double(covered) / double(r.sky_pixels) : 0.0;
+        }
         r.shadowed = image_metrics(p.shadowed, p.truth, p.mask, options.ssim);
         r.unshadowed = image_metrics(p.unshadowed, p.truth, p.mask, options.ssim);
 
@@ -407,6 +427,12 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
         result.pooled_normal = angle_stats(std::move(pooled_angles));
         result.pooled_normal.missing = missing;
     }
+    std::size_t sky_pixels = 0;
+    double sky_covered = 0;
+    for (const GtEnvImageResult& r : result.images)
+        sky_pixels += r.sky_pixels, sky_covered += r.sky_alpha_fraction * double(r.sky_pixels);
+    result.has_sky = sky_pixels > 0;
+    result.sky_alpha_fraction = result.has_sky ? sky_covered / double(sky_pixels) : 0.0;
     std::vector<double> render_ms;
     for (const GtEnvImageResult& r : result.images) render_ms.push_back(r.render_ms);
     if (!render_ms.empty()) {

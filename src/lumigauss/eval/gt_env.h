@@ -26,7 +26,11 @@
 //    is compared (a) linearised, a^2.2, against gt/albedo ("albedo", primary) and (b) as it is against
 //    gt/albedo^(1/2.2) ("albedo_gamma"), each after ONE per-channel least-squares scale pooled over all test
 //    images' masked pixels, then clamped to [0, 1]; PSNR/MSE/MAE with the official formulas.
-// 5. Normals (when gt/normal exists): the rasterised world normal map, normalised, against gt/normal decoded
+// 5. Sky (when gt/mask exists): the share of the pixels that see no geometry (gt/mask = 0) where the
+//    render's alpha exceeds 0.5. A run trained with the sky background (config.json "sky_background") is
+//    rendered as it was trained, the sky of the evaluation light drawn behind its surfels (the metrics'
+//    mask excludes the sky, so this changes only edge pixels and the contact sheets).
+// 6. Normals (when gt/normal exists): the rasterised world normal map, normalised, against gt/normal decoded
 //    as 2v - 1 and normalised; angles in degrees over the evaluation mask; a pixel with no rendered normal
 //    counts as 90 deg. Per image mean and median; overall the mean of those and the pooled statistics.
 // Ground-truth images are area-resampled to the evaluated resolution (-r) like the photos.
@@ -74,6 +78,7 @@ struct RelightableRun {
     std::vector<std::string> image_names;      // appearance.json, in embedding order
     std::vector<ShCoeffs<double>> learned_sh;  // the lighting MLP's env_sh(i) of each of them
     int downscale = 0;                         // config.json "downscale"; 0 if unknown
+    bool sky_background = false;               // trained with the photo's sky behind the surfels
 };
 
 // model.ply, lighting.lgmlp, appearance.json (and config.json if present) of a run folder. Throws Error
@@ -132,6 +137,10 @@ struct GtEnvImageResult {
     double exposure = 1.0;
     std::size_t mask_pixels = 0;
     double render_ms = 0;  // wall time of the one 6-channel render (shadowed + unshadowed + maps)
+    // Sky pixels (gt/mask exactly 0) and the share of them where the render's alpha exceeds 0.5: surfels
+    // painting the sky seen from a new viewpoint. 0 pixels when the scene has no gt/mask.
+    std::size_t sky_pixels = 0;
+    double sky_alpha_fraction = 0;
     ImageMetrics shadowed, unshadowed;
     bool has_albedo = false, has_normal = false;
     AlbedoMetrics albedo, albedo_gamma;
@@ -149,6 +158,8 @@ struct GtEnvResult {
     // Means over images (PSNR averaged as PSNR, as officially).
     ImageMetrics mean_shadowed, mean_unshadowed;
     double median_render_ms = 0;
+    bool has_sky = false;           // some scored image had sky pixels
+    double sky_alpha_fraction = 0;  // over every sky pixel of every scored image
     std::array<double, 3> albedo_scale{1, 1, 1}, albedo_gamma_scale{1, 1, 1};
     AlbedoMetrics mean_albedo, mean_albedo_gamma;
     AngularErrorStats mean_normal;    // mean of the per-image means and of the per-image medians

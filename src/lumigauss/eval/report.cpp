@@ -195,6 +195,8 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
         if (im.has_albedo)
             e["albedo"] = albedo_json(im.albedo), e["albedo_gamma"] = albedo_json(im.albedo_gamma);
         if (im.has_normal) e["normal"] = normal_json(im.normal);
+        if (im.sky_pixels > 0)
+            e["sky"] = {{"pixels", im.sky_pixels}, {"alpha_above_half", number(im.sky_alpha_fraction)}};
         images.push_back(std::move(e));
     }
     j["images"] = images;
@@ -204,6 +206,11 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
     if (r.has_albedo)
         mean["albedo"] = albedo_json(r.mean_albedo), mean["albedo_gamma"] = albedo_json(r.mean_albedo_gamma);
     if (r.has_normal) mean["normal"] = normal_json(r.mean_normal, false);
+    if (r.has_sky)
+        mean["sky_alpha_above_half"] = {
+            {"value", number(r.sky_alpha_fraction)},
+            {"meaning",
+             "share of all sky pixels (gt/mask = 0) of the scored images where the render's alpha > 0.5"}};
     j["mean"] = mean;
     j["median_render_ms"] = r.median_render_ms;
     if (r.has_normal) j["normal_all_pixels"] = normal_json(r.pooled_normal);
@@ -267,6 +274,9 @@ std::string gt_env_report_markdown(const GtEnvResult& r, const ReportSources& sr
              " deg (means of the per-image values); over all pixels: mean " +
              fmt("%.2f", r.pooled_normal.mean_deg) + ", median " + fmt("%.2f", r.pooled_normal.median_deg) +
              " deg.\n";
+    if (r.has_sky)
+        s += "\nSky pixels (`gt/mask` = 0) covered by surfels (alpha > 0.5): " +
+             fmt("%.2f", 100 * r.sky_alpha_fraction) + " %.\n";
     s += "\n## Per image\n\n| image | condition | exposure | PSNR sh. | SSIM sh. | PSNR unsh. | SSIM unsh. | "
          "albedo PSNR | normal mean / median |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
     for (const GtEnvImageResult& im : r.images)

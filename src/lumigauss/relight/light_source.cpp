@@ -63,7 +63,8 @@ ResolvedLight file_light(const std::string& path, LightKind kind, const Panorama
     light.kind = kind;
     light.source = path;
     if (!fs::exists(path)) fail_in_file(path, "missing (the --light file)");
-    light.sh = kind == LightKind::ShFile ? read_sh_text(path) : panorama_light(path, options, &light.boosted);
+    light.sh = kind == LightKind::ShFile ? read_sh_text(path)
+                                         : panorama_light(path, options, &light.boosted, &light.panorama);
     return light;
 }
 
@@ -106,14 +107,17 @@ std::size_t fake_hdr_boost(Image& pano, double threshold, double scale) {
     return changed;
 }
 
-ShCoeffs<double> panorama_light(const std::string& path, const PanoramaOptions& options, bool* boosted) {
+ShCoeffs<double> panorama_light(const std::string& path, const PanoramaOptions& options, bool* boosted,
+                                Image* pixels) {
     Image pano = read_image(path);
     bool changed = false;
     if (is_ldr_panorama(path) && options.hdr_scale != 1.0)
         changed = fake_hdr_boost(pano, options.hdr_threshold, options.hdr_scale) > 0;
     if (boosted) *boosted = changed;
     try {
-        return project_panorama_to_sh(pano, options.frame);
+        const ShCoeffs<double> sh = project_panorama_to_sh(pano, options.frame);
+        if (pixels) *pixels = std::move(pano);
+        return sh;
     } catch (const Error& e) {
         fail_in_file(path, e.what());
     }

@@ -36,6 +36,7 @@ struct ResolvedLight {
     int photo_index = -1;
     bool boosted = false;  // the fake HDR boost changed some pixel
     ShCoeffs<double> sh;
+    Image panorama;  // a panorama light's pixels as used (boosted), for drawing its sky; else empty
 };
 
 // True for the extensions read as LDR panoramas (.png, .jpg, .jpeg; case-insensitive).
@@ -50,7 +51,7 @@ std::size_t fake_hdr_boost(Image& pano, double threshold, double scale);
 // Reads a panorama, boosts it if it is LDR and options.hdr_scale != 1, and projects it onto the SH in
 // options.frame. Throws Error naming the file when it cannot be read or holds a non-finite value.
 ShCoeffs<double> panorama_light(const std::string& path, const PanoramaOptions& options,
-                                bool* boosted = nullptr);
+                                bool* boosted = nullptr, Image* pixels = nullptr);
 
 // Resolves `--light` against a run (see above). Throws Error naming the argument, with a few of the run's
 // photo names, when it is neither a photo nor an existing file of a known kind; or naming the file when it

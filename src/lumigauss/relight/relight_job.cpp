@@ -8,8 +8,10 @@
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/relight/orbit.h"
 #include "lumigauss/relight/relit_render.h"
+#include "lumigauss/relight/relit_sky.h"
 #include "lumigauss/relight/up_axis.h"
 #include "lumigauss/relight/video.h"
+#include "lumigauss/shading/sky_image.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {
@@ -120,6 +122,27 @@ RelightCameras relight_cameras(const RelightJob& job, const TrainedRun& run) {
     return rc;
 }
 
+namespace {
+
+// The sky of one frame: the panorama itself for a panorama light, else the SH (with the photo's residual
+// when the light is a training photo of a run that learned one, not turned).
+Image frame_sky(const Camera& camera, const RelightSummary& summary, const TrainedRun& run,
+                const ShCoeffs<float>& env, const Mat3d& frame, double degrees) {
+    const ResolvedLight& light = summary.light;
+    if (light.kind == LightKind::Panorama && !light.panorama.pixels.empty())
+        return panorama_sky_image(camera,
+                                  {&light.panorama, frame, summary.light_factor, summary.up, degrees});
+    if (light.kind == LightKind::Photo && degrees == 0 && !run.sky_residuals.empty() &&
+        light.photo_index >= 0 && light.photo_index < run.sky_residuals.num_images()) {
+        Sh4Coeffs<float> residual = run.sky_residuals.get(light.photo_index);
+        for (Vec3f& c : residual.c) c = float(summary.light_factor) * c;
+        return sky_image(camera, env, &residual);
+    }
+    return sky_image(camera, env);
+}
+
+}  // namespace
+
 RelightSummary run_relight_job(const RelightJob& job, const std::function<void(const std::string&)>& log) {
     auto say = [&](const std::string& line) {
         if (log) log(line);
@@ -170,7 +193,11 @@ RelightSummary run_relight_job(const RelightJob& job, const std::function<void(c
             const std::string stem = job.spin > 0 ? frame_name(nc.name + "_spin", int(k), job.spin) : nc.name;
             const ShCoeffs<float> env = rotate_about_up(base, cams.up, angles[k]).cast<float>();
             const RasterImages<float>& raster = renderer.render(nc.camera, env);
-            const std::vector<std::string> files = write_relit_frame(job.out, stem, raster, job.outputs);
+            Image sky;
+            if (job.outputs.sky_background)
+                sky = frame_sky(nc.camera, summary, run, env, popt.frame, angles[k]);
+            const std::vector<std::string> files = write_relit_frame(
+                job.out, stem, raster, job.outputs, job.outputs.sky_background ? &sky : nullptr);
             ++summary.frames;
             const double ms =
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -49,7 +49,8 @@ std::string relit_path(const std::string& dir, const std::string& stem, const st
 }
 
 std::vector<std::string> write_relit_frame(const std::string& dir, const std::string& stem,
-                                           const RasterImages<float>& raster, const RelitOutputs& o) {
+                                           const RasterImages<float>& raster, const RelitOutputs& o,
+                                           const Image* sky) {
     std::filesystem::create_directories(std::filesystem::path(relit_path(dir, stem, "")).parent_path());
     std::vector<std::string> written;
     auto png = [&](const std::string& suffix, const Image& im) {
@@ -63,7 +64,10 @@ std::vector<std::string> write_relit_frame(const std::string& dir, const std::st
     const Image alpha = alpha_image(raster);
     auto colour = [&](const std::string& suffix, int first) {
         Image im = raster_channels(raster, first, 3);
-        if (o.has_background) im = over_background(im, alpha, o.background);
+        if (o.sky_background && sky != nullptr && first != kRelitAlbedo)
+            im = over_background_image(im, alpha, *sky);
+        else if (o.has_background)
+            im = over_background(im, alpha, o.background);
         png(suffix, im);
         if (o.exr) exr(suffix, im);
     };

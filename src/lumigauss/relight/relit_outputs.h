@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "lumigauss/io/image.h"
 #include "lumigauss/math/vec.h"
 #include "lumigauss/render/raster_types.h"
 
@@ -28,6 +29,7 @@ struct RelitOutputs {
     bool exr = false;
     bool has_background = false;  // composite colour and albedo over `background` (else black)
     Vec3f background{};
+    bool sky_background = false;  // composite colour over the light's sky (relit_sky.h) instead
 };
 
 // "all" or a comma-separated subset of shadowed, unshadowed, albedo, normal, shadow, irradiance, depth,
@@ -39,7 +41,9 @@ std::string relit_path(const std::string& dir, const std::string& stem, const st
 
 // Writes the selected files of one frame from the RelitRenderer output (creating the sub-folders of the
 // stem) and returns their paths.
+// `sky` (3 channels, the frame's size) is the background of the colour maps when outputs.sky_background.
 std::vector<std::string> write_relit_frame(const std::string& dir, const std::string& stem,
-                                           const RasterImages<float>& raster, const RelitOutputs& outputs);
+                                           const RasterImages<float>& raster, const RelitOutputs& outputs,
+                                           const Image* sky = nullptr);
 
 }  // namespace lumigauss

@@ -89,4 +89,12 @@ Image over_background(const Image& colour, const Image& alpha, const Vec3f& back
     return out;
 }
 
+Image over_background_image(const Image& colour, const Image& alpha, const Image& background) {
+    Image out = colour;
+    for (std::size_t p = 0; p < alpha.pixels.size(); ++p)
+        for (std::size_t c = 0; c < 3; ++c)
+            out.pixels[3 * p + c] += (1.0f - alpha.pixels[p]) * background.pixels[3 * p + c];
+    return out;
+}
+
 }  // namespace lumigauss

@@ -54,5 +54,7 @@ Image divided(const Image& image, float divisor);
 
 // colour + (1 - alpha) * background, per channel (3-channel images).
 Image over_background(const Image& colour, const Image& alpha, const Vec3f& background);
+// The same over a background image of the same size (3 channels), e.g. the sky (shading/sky_image.h).
+Image over_background_image(const Image& colour, const Image& alpha, const Image& background);
 
 }  // namespace lumigauss
