@@ -15,6 +15,7 @@ namespace {
 struct InfoOptions {
     std::string scene;
     int downscale = 1;
+    std::string masks = "transient";
 };
 
 // "128x96 (20), 64x48 (3)": distinct values with how many views have each.
@@ -25,19 +26,31 @@ std::string counted(const std::map<std::string, int>& counts) {
     return out.empty() ? "none" : out;
 }
 
-void print_views(const Dataset& d) {
+void print_views(const Dataset& d, const std::string& mask_mode) {
     std::printf("views:         %zu (train %zu, test %zu, validation %zu)\n", d.views.size(),
                 d.split(Split::Train).size(), d.split(Split::Test).size(), d.split(Split::Validation).size());
     std::map<std::string, int> sizes, models;
-    int masks = 0;
+    int masks = 0, sky_masks = 0;
     for (const View& v : d.views) {
         ++sizes[std::to_string(v.camera.width) + "x" + std::to_string(v.camera.height)];
         ++models[v.camera_model];
         masks += v.mask_path.empty() ? 0 : 1;
+        sky_masks += v.sky_mask_path.empty() ? 0 : 1;
     }
     std::printf("downscale:     %d\nresolutions:   %s\n", d.downscale, counted(sizes).c_str());
     std::printf("camera models: %s\n", counted(models).c_str());
-    std::printf("masks:         %d of %zu views\n", masks, d.views.size());
+    std::printf("masks:         %d of %zu views", masks, d.views.size());
+    if (masks > 0)
+        std::printf(", taken as %s\n", mask_mode == "object"
+                                           ? "object masks (0 = empty space: nothing may be drawn there)"
+                                           : "transient masks (0 = ignore the pixel; train --set "
+                                             "mask_mode=object for foreground masks of one object)");
+    else
+        std::printf("\n");
+    std::printf("sky masks:     %d of %zu views%s\n", sky_masks, d.views.size(),
+                sky_masks > 0
+                    ? " (255 = sky: kept empty, and the sky drawn behind the surfels is fitted to it)"
+                    : " (the sky is then found where the drawn sky already matches the photo)");
 }
 
 void print_extent(const Dataset& d) {
@@ -59,7 +72,7 @@ void run_info(const InfoOptions& o) {
     options.downscale = o.downscale;
     const Dataset d = load_dataset(o.scene, options);
     std::printf("scene:         %s\nformat:        %s\n", d.root.c_str(), d.format.c_str());
-    print_views(d);
+    print_views(d, o.masks);
     print_extent(d);
 }
 
@@ -74,6 +87,8 @@ void register_info(CLI::App& app) {
         ->required();
     cmd->add_option("-r,--resolution", options->downscale, "Downscale images by 1, 2, 4 or 8")
         ->check(CLI::IsMember({1, 2, 4, 8}));
+    cmd->add_option("--masks", options->masks, "How train takes the masks: transient (default) or object")
+        ->check(CLI::IsMember({"transient", "object"}));
     cmd->callback([options] { run_info(*options); });
 }
 

@@ -17,7 +17,7 @@ struct SynthFlags {
     int width = 0, height = 0, train = 0, test = 0, spp_side = 0, points = 0, gt_surfels = 0;
     unsigned long long seed = 1;
     double transients = 0;
-    bool force = false, verbose = false;
+    bool force = false, verbose = false, object_masks = false;
     CLI::Option *o_width, *o_height, *o_train, *o_test, *o_transients, *o_spp, *o_points, *o_gt_surfels;
 };
 
@@ -34,6 +34,7 @@ synth::SynthOptions to_options(const SynthFlags& f) {
     if (f.o_spp->count()) o.samples_per_side = f.spp_side;
     if (f.o_points->count()) o.point_candidates = f.points;
     if (f.o_gt_surfels->count()) o.gt_surfels = f.gt_surfels;
+    o.object_masks = f.object_masks;
     o.overwrite = f.force;
     o.verbose = f.verbose;
     return o;
@@ -86,6 +87,10 @@ void register_synth(CLI::App& app) {
         cmd->add_option("--gt-surfels", f->gt_surfels,
                         "About how many ground-truth surfels to write to gt/surfels.ply (0: no file)")
             ->check(CLI::Range(0, 10000000));
+    cmd->add_flag(
+        "--object-masks", f->object_masks,
+        "Write masks/ as foreground masks of the landmark (255 on it, 0 on the ground, people and sky), "
+        "as collections of one object come (train with --set mask_mode=object)");
     cmd->add_flag("--force", f->force, "Replace the dataset files of an existing output folder");
     cmd->add_flag("-v,--verbose", f->verbose, "Print each photo as it is rendered");
     cmd->callback([f] { run_synth(*f); });

@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // What a synthetic dataset consists of; only these are removed when overwriting.
-const char* const kOwnFolders[] = {"images", "masks", "gt", "env", "sparse"};
+const char* const kOwnFolders[] = {"images", "masks", "sky_masks", "gt", "env", "sparse"};
 const char* const kOwnFiles[] = {"meta.json", "split.csv", "README.md"};
 const char* const kGtPasses[] = {"albedo", "normal", "mask", "transient", "sun_visibility"};
 
@@ -48,15 +48,15 @@ void prepare_output_dir(const SynthOptions& options) {
         for (const char* f : kOwnFolders) fs::remove_all(root / f, ec);
         for (const char* f : kOwnFiles) fs::remove(root / f, ec);
     }
-    for (const char* f : {"images", "masks", "env", "sparse/0"}) make_dirs(root / f);
+    for (const char* f : {"images", "masks", "sky_masks", "env", "sparse/0"}) make_dirs(root / f);
     for (const char* pass : kGtPasses) make_dirs(root / "gt" / pass);
 }
 
-std::vector<std::uint8_t> write_photo_files(const std::string& dir, const Photo& photo,
-                                            const ViewBuffers& b) {
+std::vector<std::uint8_t> write_photo_files(const std::string& dir, const Photo& photo, const ViewBuffers& b,
+                                            bool object_masks) {
     const int w = b.width, h = b.height;
     Image rgb(w, h, 3), albedo(w, h, 3), normal(w, h, 3);
-    Image mask(w, h, 1), transient(w, h, 1), static_mask(w, h, 1), sun(w, h, 1);
+    Image mask(w, h, 1), transient(w, h, 1), static_mask(w, h, 1), sun(w, h, 1), sky(w, h, 1);
     std::vector<std::uint8_t> rgb8(std::size_t(w) * h * 3);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
@@ -69,14 +69,18 @@ std::vector<std::uint8_t> write_photo_files(const std::string& dir, const Photo&
                 normal.at(x, y, c) = code(quantize(0.5 * (b.normal[i][c] + 1.0), 65535), 65535);
             }
             const int t = quantize(b.transient[i], 255);
-            mask.at(x, y, 0) = code(quantize(b.coverage[i], 255), 255);
+            const int coverage = quantize(b.coverage[i], 255);
+            mask.at(x, y, 0) = code(coverage, 255);
+            sky.at(x, y, 0) = code(255 - coverage, 255);
             transient.at(x, y, 0) = code(t, 255);
-            static_mask.at(x, y, 0) = code(255 - t, 255);
+            static_mask.at(x, y, 0) =
+                object_masks ? code(quantize(b.landmark[i], 255), 255) : code(255 - t, 255);
             sun.at(x, y, 0) = code(quantize(b.sun_visible[i], 255), 255);
         }
     const std::string name = photo.name;
     write_png(dir + "/images/" + name, rgb, 8);
     write_png(dir + "/masks/" + name, static_mask, 8);
+    write_png(dir + "/sky_masks/" + name, sky, 8);
     write_png(dir + "/gt/albedo/" + name, albedo, 16);
     write_png(dir + "/gt/normal/" + name, normal, 16);
     write_png(dir + "/gt/mask/" + name, mask, 8);

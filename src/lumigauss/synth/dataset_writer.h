@@ -29,9 +29,12 @@ struct Photo {
 // the dataset's own files and folders).
 void prepare_output_dir(const SynthOptions& options);
 
-// images/NAME (8-bit sRGB), masks/NAME, gt/{albedo,normal,mask,transient,sun_visibility}/NAME.
+// images/NAME (8-bit sRGB), masks/NAME, sky_masks/NAME (255 - gt/mask: the pixel sees no geometry),
+// gt/{albedo,normal,mask,transient,sun_visibility}/NAME.
 // Returns the photo's 8-bit RGB pixels (interleaved) for the point colours.
-std::vector<std::uint8_t> write_photo_files(const std::string& dir, const Photo& photo, const ViewBuffers& b);
+// With object_masks, masks/NAME is the landmark's coverage (SynthOptions::object_masks).
+std::vector<std::uint8_t> write_photo_files(const std::string& dir, const Photo& photo, const ViewBuffers& b,
+                                            bool object_masks = false);
 
 // env/COND_sh.txt (sky + sun), env/COND.exr (equirect radiance 128 x 64), env/COND.png (sRGB preview).
 void write_environment(const std::string& dir, const LightCondition& c);

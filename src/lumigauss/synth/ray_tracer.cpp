@@ -17,7 +17,7 @@ namespace {
 
 struct Sample {
     Vec3d radiance, albedo, normal;
-    bool geometry = false, transient = false, sun_visible = false;
+    bool geometry = false, transient = false, sun_visible = false, landmark = false;
 };
 
 Sample trace_sample(const World& world, const LightCondition& light, const Ray& ray) {
@@ -32,6 +32,7 @@ Sample trace_sample(const World& world, const LightCondition& light, const Ray& 
     const Vec3d n = hit->hit.normal;
     s.geometry = true;
     s.transient = prim.transient;
+    s.landmark = !prim.transient && hit->prim != 0;  // the landmark's world holds the ground first
     s.normal = n;
     s.albedo = albedo_at(world.materials[prim.material], hit->hit.u, hit->hit.v);
     s.sun_visible = dot(n, light.sun_dir) > 0 && !occluded(world, Ray{p + kRayEpsilon * n, light.sun_dir});
@@ -59,7 +60,8 @@ ViewBuffers render_view(const World& world, const LightCondition& light, const C
     b.width = w, b.height = h;
     const std::size_t count = std::size_t(w) * h;
     b.radiance.resize(count), b.albedo.resize(count), b.normal.resize(count);
-    b.coverage.resize(count), b.transient.resize(count), b.sun_visible.resize(count);
+    b.coverage.resize(count), b.transient.resize(count), b.sun_visible.resize(count),
+        b.landmark.resize(count);
     const double inv = 1.0 / (n * n);
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
         for (int y = rows.begin(); y < rows.end(); ++y)
@@ -68,16 +70,17 @@ ViewBuffers render_view(const World& world, const LightCondition& light, const C
                         std::uint64_t(y) * std::uint64_t(w) + std::uint64_t(x));
                 const std::size_t i = std::size_t(y) * w + x;
                 Vec3d rad, alb, nor;
-                double cov = 0, tra = 0, sun = 0;
+                double cov = 0, tra = 0, sun = 0, obj = 0;
                 for (int sy = 0; sy < n; ++sy)
                     for (int sx = 0; sx < n; ++sx) {
                         const double px = x + (sx + rng.uniform()) / n, py = y + (sy + rng.uniform()) / n;
                         const Sample s = trace_sample(world, light, camera_ray(camera, px, py));
                         rad += s.radiance, alb += s.albedo, nor += s.normal;
-                        cov += s.geometry, tra += s.transient, sun += s.sun_visible;
+                        cov += s.geometry, tra += s.transient, sun += s.sun_visible, obj += s.landmark;
                     }
                 b.radiance[i] = inv * rad, b.albedo[i] = inv * alb, b.normal[i] = inv * nor;
                 b.coverage[i] = inv * cov, b.transient[i] = inv * tra, b.sun_visible[i] = inv * sun;
+                b.landmark[i] = inv * obj;
             }
     });
     return b;

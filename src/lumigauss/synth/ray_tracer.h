@@ -32,6 +32,7 @@ struct ViewBuffers {
     std::vector<double> coverage;     // fraction of samples on any geometry
     std::vector<double> transient;    // fraction of samples on a pedestrian
     std::vector<double> sun_visible;  // fraction of samples lit by the sun (facing it and unshadowed)
+    std::vector<double> landmark;  // fraction of samples on the landmark (not the ground, not a pedestrian)
 };
 
 ViewBuffers render_view(const World& world, const LightCondition& light, const Camera& camera,

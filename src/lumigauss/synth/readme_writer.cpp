@@ -83,7 +83,12 @@ const char* const kLayoutRows[][2] = {
      "9 lines `R G B`: radiance SH coefficients L_lm of that environment (sun included)"},
     {"`masks/NAME.png`",
      "8-bit gray static-scene training mask, as users supply with photo collections: 255 = "
-     "use, 0 = transient (pedestrian); = 255 - gt/transient"},
+     "use, 0 = transient (pedestrian); = 255 - gt/transient. With `synth --object-masks`: the landmark's "
+     "coverage instead (255 on the building, 0 on the ground, pedestrians and sky), to be trained with "
+     "`--set mask_mode=object`"},
+    {"`sky_masks/NAME.png`",
+     "8-bit gray sky mask, as a semantic segmentation of the photo gives it: 255 = sky (fraction of "
+     "the pixel that sees no geometry), 0 = anything else; = 255 - gt/mask"},
     {"`split.csv`", "`filename;split` (train/test) for every image"},
     {"`sparse/0/{cameras,images,points3D}.txt`",
      "COLMAP text model (PINHOLE, one camera per image, camera id = image id)"},

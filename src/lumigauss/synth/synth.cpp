@@ -122,7 +122,7 @@ TrainingPhotos render_photos(const SynthOptions& o, const Landmark& landmark,
         const LightCondition& light = conditions[std::size_t(p.condition)];
         const ViewBuffers buffers =
             render_view(world, light, p.camera, {o.samples_per_side, o.seed, p.image_id});
-        auto rgb8 = write_photo_files(o.output_dir, p, buffers);
+        auto rgb8 = write_photo_files(o.output_dir, p, buffers, o.object_masks);
         if (p.train) training.worlds.push_back(std::move(world)), training.rgb.push_back(std::move(rgb8));
         if (o.verbose) std::printf("synth: %s (%s)\n", p.name.c_str(), light.id.c_str());
     }

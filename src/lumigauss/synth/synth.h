@@ -22,8 +22,11 @@ struct SynthOptions {
     int point_candidates = 8000;            // surface samples tried for points3D
     double point_noise = 0.005;             // RMS point position noise, as a fraction of the scene diagonal
     int gt_surfels = 60000;                 // about this many ground-truth surfels (gt/surfels.ply); 0: none
-    bool overwrite = false;                 // replace an existing non-empty output folder's dataset files
-    bool verbose = false;                   // progress on stdout
+    // masks/ as foreground masks of the landmark alone (255 on it; 0 on the ground, pedestrians and sky), as
+    // photo collections of one object come; train them with mask_mode=object.
+    bool object_masks = false;
+    bool overwrite = false;  // replace an existing non-empty output folder's dataset files
+    bool verbose = false;    // progress on stdout
 };
 
 // Presets: "tiny" (64x48, 8 train + 2 test: unit tests, ~1 s), "demo" (160x120, 40 + 6: tens of seconds on
