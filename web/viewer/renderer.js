@@ -126,8 +126,8 @@ export class SplatRenderer {
   }
 
   // view: {R (rows), t, fx, fy, cx, cy, width, height}; env: Float32Array(27); mode: a MODES name;
-  // ball: null or {mode: 0|1, size (pixels)}.
-  render(view, env, mode, ball) {
+  // ball: null or {mode: 0|1, size (pixels)}; sky: draw the light's sky behind the colour views.
+  render(view, env, mode, ball, sky = false) {
     const gl = this.gl;
     const { width, height } = view;
     if (this.canvas.width !== width || this.canvas.height !== height) {
@@ -175,6 +175,11 @@ export class SplatRenderer {
     gl.uniform1i(c.u.u_accum, 0);
     gl.uniform1i(c.u.u_mode, m);
     gl.uniform1i(c.u.u_unitRange, this.floatTarget ? 0 : 1);
+    gl.uniform1i(c.u.u_sky, sky ? 1 : 0);
+    this.setCamera(c.u, view);
+    gl.uniform4f(c.u.u_intr, view.fx, view.fy, view.cx, view.cy);
+    gl.uniform2f(c.u.u_size, width, height);
+    gl.uniform3fv(c.u.u_env, env);
     gl.bindVertexArray(this.emptyVao);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
     // 3. The environment ball in the top right corner.

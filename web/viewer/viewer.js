@@ -92,6 +92,7 @@ class Viewer {
     this.exposure = 0;
     this.mode = 'shadowed';
     this.ball = { mode: 0, size: 110 };
+    this.sky = !!scene.sky_background;  // runs trained with the sky behind their surfels show it
     this.renderer = new SplatRenderer($('canvas'));
     this.renderer.setModel(packSplats(model, this.renderer.maxTextureSize));
     this.camera = new OrbitCamera(scene);
@@ -118,7 +119,8 @@ class Viewer {
   }
 
   draw(view, withBall = true) {
-    this.renderer.render(view, this.env, this.mode, withBall && this.ball.mode !== 'off' ? this.ball : null);
+    this.renderer.render(view, this.env, this.mode, withBall && this.ball.mode !== 'off' ? this.ball : null,
+                         this.sky);
   }
 
   // --- interactive use ---
@@ -177,6 +179,8 @@ class Viewer {
     };
     $('mode').onchange = (e) => { this.mode = e.target.value; touch(); };
     $('ball').onchange = (e) => { this.ball.mode = e.target.value === 'off' ? 'off' : Number(e.target.value); touch(); };
+    $('background').value = this.sky ? 'sky' : 'black';
+    $('background').onchange = (e) => { this.sky = e.target.value === 'sky'; touch(); };
     $('reset').onclick = () => { this.camera.reset(); touch(); };
     $('shfile').onchange = (e) => this.loadShFile(e.target.files[0]);
     this.bindPointer($('canvas'));

@@ -63,6 +63,7 @@ ViewerScene describe_scene(const TrainedRun& run, const std::vector<ResolvedLigh
     scene.surfels = run.model.size();
     scene.up = up;
     scene.camera = std::move(camera);
+    scene.sky_background = run.sky_background;
     model_extent(run.model, scene);
     for (const ResolvedLight& l : extra_lights)
         scene.lights.push_back({light_name(l), light_kind_name(l.kind), l.sh});
@@ -90,7 +91,8 @@ std::string scene_json(const ViewerScene& scene) {
               {"radius", scene.radius},
               {"camera", scene.camera ? camera_json(*scene.camera) : json(nullptr)},
               {"lights", lights},
-              {"initial_light", 0}};
+              {"initial_light", 0},
+              {"sky_background", scene.sky_background}};
     return j.dump();
 }
 

@@ -38,6 +38,7 @@ struct ViewerScene {
     double radius = 1;
     std::optional<Camera> camera;  // the initial view when known (--scene, --camera)
     std::vector<ViewerLight> lights;
+    bool sky_background = false;  // the run was trained with its sky drawn behind the surfels
 };
 
 // The uniform environment: radiance 1 / pi in every direction, so irradiance(L, n) = 1 for every n.
