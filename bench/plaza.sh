@@ -1,20 +1,30 @@
 #!/usr/bin/env bash
-# Trains LumiGauss on a scene with ground-truth lighting (default: ../shared/data/plaza) with the paper preset,
-# evaluates it with the gt-env protocol (novel views under novel lights), and prints one table.
+# Trains LumiGauss on a scene with ground-truth lighting (default: ../shared/data/plaza), evaluates every run
+# with the gt-env protocol on the test views (novel views under novel lights) and on the training views
+# (each under its own true light), and prints one table.
 #
-#   bench/plaza.sh [--scene DIR] [--runs DIR] [--build DIR] [--preset paper|fast] [--ablations] [-- TRAIN ARGS]
+#   bench/plaza.sh [--scene DIR] [--runs DIR] [--build DIR] [--rows LIST] [--ablations] [--paper-ablations]
+#                  [-- TRAIN ARGS]
+#
+# Rows (--rows, comma-separated; default "default,paper,fast"):
+#   default        the default preset (40k iterations, sky and floater handling)
+#   paper          the official LumiGauss (40k)
+#   fast           the fast variant of the default preset (3k)
+#   paper-fast     the official schedule shrunk to 3k
+# --ablations adds, on the fast preset, each improvement of the default preset switched off alone (issue #25):
+#   fast-no-point-normals   surfels start randomly turned, as officially (init_normals_from_points=false)
+#   fast-no-sky             no sky behind the surfels (sky_background=false: the sky losses go with it)
+#   fast-no-sky-alpha       the sky masks do not push alpha to 0 (lambda_sky_alpha=0)
+#   fast-no-sky-free-reg    the normal/distortion losses also on sky pixels (sky_free_regularizers=false)
+#   fast-no-prune-end       nothing pruned after densification, as officially (prune_until_end=false)
+#   fast-no-sky-masks       the scene's sky masks ignored (use_sky_masks=false): the background-explained
+#                           pixels carry the alpha penalty instead
+#   fast-no-sky-masks-no-bg-alpha   and without that penalty either (lambda_background_alpha=0)
+# --paper-ablations adds the paper's own ablation rows (Table 1, lower part) on the paper preset:
+#   no_stage1, no_cons_unsh, no_range01, no_env_pos (see bench/RESULTS.md, session 6).
 #
 # Runs go to --runs (default runs/<scene name>): a run that has its model is only evaluated again; one with a
 # checkpoint is resumed (so an interrupted benchmark continues where it stopped); otherwise it is trained.
-# --ablations adds the rows of the paper's ablation (Table 1, lower part), each a full training:
-#   no_stage1      without the unshadowed warm-up: transfer fitting from iteration 1 (warmup=1, then the preset's
-#                  stage-2 length: 500 iterations as officially, 100 in the fast preset), then shadowed.
-#                  (Densification then runs in stage 3 until 15k: the official rule accumulates statistics
-#                  outside stage 2, i.e. before warmup or after start_shadowed.)
-#   no_cons_unsh   without l_consistency and the unshadowed reconstruction term in the last stage
-#                  (consistency_final_ratio=0, lambda_unshadowed_stage3=0; stage 2 still fits the transfer)
-#   no_range01     without l_[0,1] (lambda_range01=0)
-#   no_env_pos     without l_+ (lambda_env=0)
 # Training time is the wall time summed over the run's log segments (a resumed run adds its segments).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,16 +32,18 @@ cd "$(dirname "$0")/.."
 scene=../shared/data/plaza
 runs=""
 build=build
-preset=paper
+rows="default,paper,fast"
 ablations=0
+paper_ablations=0
 extra=()
 while [[ $# -gt 0 ]]; do
     case "$1" in
         --scene) scene="$2"; shift 2 ;;
         --runs) runs="$2"; shift 2 ;;
         --build) build="$2"; shift 2 ;;
-        --preset) preset="$2"; shift 2 ;;
+        --rows) rows="$2"; shift 2 ;;
         --ablations) ablations=1; shift ;;
+        --paper-ablations) paper_ablations=1; shift ;;
         --) shift; extra=("$@"); break ;;
         *) echo "bench/plaza.sh: unknown option '$1'" >&2; exit 2 ;;
     esac
@@ -42,15 +54,29 @@ runs="${runs:-runs/$(basename "$scene")}"
 bin="$build/lumigauss"
 [[ -x "$bin" ]] || { echo "bench/plaza.sh: $bin not built (run scripts/setup.sh, or pass --build)" >&2; exit 2; }
 
-declare -a names=(baseline) settings=("")
+declare -a names=() settings=()
+add_row() { names+=("$1"); settings+=("$2"); }
+IFS=',' read -r -a wanted <<< "$rows"
+for row in "${wanted[@]}"; do
+    case "$row" in
+        default|paper|fast|paper-fast) add_row "$row" "--preset $row" ;;
+        *) echo "bench/plaza.sh: unknown row '$row' (default, paper, fast, paper-fast)" >&2; exit 2 ;;
+    esac
+done
 if [[ $ablations == 1 ]]; then
-    names+=(no_stage1 no_cons_unsh no_range01 no_env_pos)
-    # Stage 2 (transfer fitting) keeps the preset's length: 500 iterations in the paper preset, 100 in fast.
-    stage2=$([[ $preset == fast ]] && echo 100 || echo 500)
-    settings+=("--set warmup=1 --set start_shadowed=$((stage2 + 1))"
-               "--set consistency_final_ratio=0 --set lambda_unshadowed_stage3=0"
-               "--set lambda_range01=0"
-               "--set lambda_env=0")
+    add_row fast-no-point-normals "--preset fast --set init_normals_from_points=false"
+    add_row fast-no-sky "--preset fast --set sky_background=false"
+    add_row fast-no-sky-alpha "--preset fast --set lambda_sky_alpha=0"
+    add_row fast-no-sky-free-reg "--preset fast --set sky_free_regularizers=false"
+    add_row fast-no-prune-end "--preset fast --set prune_until_end=false"
+    add_row fast-no-sky-masks "--preset fast --set use_sky_masks=false"
+    add_row fast-no-sky-masks-no-bg-alpha "--preset fast --set use_sky_masks=false --set lambda_background_alpha=0"
+fi
+if [[ $paper_ablations == 1 ]]; then
+    add_row no_stage1 "--preset paper --set warmup=1 --set start_shadowed=501"
+    add_row no_cons_unsh "--preset paper --set consistency_final_ratio=0 --set lambda_unshadowed_stage3=0"
+    add_row no_range01 "--preset paper --set lambda_range01=0"
+    add_row no_env_pos "--preset paper --set lambda_env=0"
 fi
 
 # Wall time of a run: the last elapsed_s of each log segment (elapsed restarts at every resume), summed.
@@ -59,6 +85,8 @@ train_seconds() {
                                     if (t < last) total += last; last = t }
                           END { printf "%.0f", total + last }' "$1/log.jsonl"
 }
+# One key of an eval-summary line.
+summary_value() { tr ' ' '\n' <<< "$1" | sed -n "s/^$2=//p"; }
 
 summary=$(mktemp)
 trap 'rm -f "$summary"' EXIT
@@ -73,26 +101,33 @@ for i in "${!names[@]}"; do
         echo "== $name: resuming $run"
         "$bin" train "$scene" -o "$run" --resume
     else
-        echo "== $name: training ($preset preset) -> $run"
-        "$bin" train "$scene" -o "$run" --preset "$preset" "${args[@]}"
+        echo "== $name: training (${settings[$i]}) -> $run"
+        "$bin" train "$scene" -o "$run" "${args[@]}"
     fi
-    echo "== $name: evaluating (gt-env)"
-    line=$("$bin" eval "$run" --scene "$scene" --protocol gt-env -o "$run/eval" | tee /dev/stderr |
-           grep '^eval-summary:')
+    echo "== $name: evaluating (gt-env, test views, then training views)"
+    test_line=$("$bin" eval "$run" --scene "$scene" --protocol gt-env -o "$run/eval" | tee /dev/stderr |
+                grep '^eval-summary:')
+    train_line=$("$bin" eval "$run" --scene "$scene" --protocol gt-env --views train --no-sheets \
+                 -o "$run/eval_train" | grep '^eval-summary:')
     surfels=$(awk -F'"surfels":' 'NF > 1 { split($2, a, /[,}]/); s = a[1] } END { print s }' "$run/log.jsonl")
-    echo "$name $(train_seconds "$run") $surfels ${line#eval-summary: }" >> "$summary"
+    echo "$name $(train_seconds "$run") $surfels $(summary_value "$train_line" normal_median_deg)" \
+         "${test_line#eval-summary: }" >> "$summary"
 done
 
 echo
-echo "gt-env on $scene (novel views under novel lights; light scale fitted on training photos only)"
-printf '%-14s %9s %8s %9s %8s %9s %9s %9s %9s %10s %8s\n' run "shad.PSNR" "shad.SSIM" "unsh.PSNR" \
-       "unsh.SSIM" "alb.PSNR" "norm.mean" "norm.med" "train min" "surfels" "render ms"
-while read -r name seconds surfels rest; do
+echo "gt-env on $scene (test views: novel views under novel lights; light scale fitted on training photos only)"
+printf '%-30s %8s %8s %8s %8s %8s %8s %8s %8s %7s %7s %8s %8s\n' run "shad.PSNR" "shad.SSIM" "unsh.PSNR" \
+       "unsh.SSIM" "alb.PSNR" "norm.mean" "norm.med" "trainmed" "sky%" "lightres" "train min" "surfels"
+while read -r name seconds surfels train_median rest; do
     declare -A m=()
     for kv in $rest; do m[${kv%%=*}]=${kv#*=}; done
-    printf '%-14s %9.2f %8.4f %9.2f %8.4f %9.2f %9.2f %9.2f %9.1f %10s %8.1f\n' "$name" \
+    printf '%-30s %8.2f %8.4f %8.2f %8.4f %8.2f %8.2f %8.2f %8.2f %7.2f %7.3f %8.1f %8s\n' "$name" \
            "${m[shadowed_psnr]}" "${m[shadowed_ssim]}" "${m[unshadowed_psnr]}" "${m[unshadowed_ssim]}" \
-           "${m[albedo_psnr]}" "${m[normal_mean_deg]}" "${m[normal_median_deg]}" \
-           "$(awk -v s="$seconds" 'BEGIN { print s / 60 }')" "$surfels" "${m[render_ms]}"
+           "${m[albedo_psnr]}" "${m[normal_mean_deg]}" "${m[normal_median_deg]}" "$train_median" \
+           "$(awk -v s="${m[sky_alpha]}" 'BEGIN { print 100 * s }')" "${m[light_residual]}" \
+           "$(awk -v s="$seconds" 'BEGIN { print s / 60 }')" "$surfels"
     unset m
 done < "$summary"
+echo "(norm.mean/norm.med: normal error on the test views, degrees; trainmed: median normal error on the"
+echo " training views; sky%: test-view sky pixels (gt/mask = 0) where the render's alpha > 0.5; lightres:"
+echo " relative residual of the light-scale fit, 0 when every learned light is one common scale of the true one)"

@@ -20,12 +20,21 @@ echo "== 3/6 rendering the ground-truth surfel model of the scene from every cam
 echo "== 4/6 training a relightable model (fast preset: 1500 unshadowed, 100 transfer, 1400 shadowed iterations)"
 "$bin" train "$out/scene" -o "$out/run" --preset fast --force
 echo "== 5/6 evaluating novel views under novel lights (gt-env protocol)"
-"$bin" eval "$out/run" --scene "$out/scene" --protocol gt-env -o "$out/eval"
+summary=$("$bin" eval "$out/run" --scene "$out/scene" --protocol gt-env -o "$out/eval" | tee /dev/stderr |
+          grep '^eval-summary:')
 echo "== 6/6 relighting the test views under the first sky of the scene, turned in 8 steps"
 sky=$(ls "$out/scene/env/"*_sh.txt | head -n 1)
 "$bin" render "$out/run" --scene "$out/scene" --cameras test --light "$sky" --match-exposure --spin 8 \
+    --background sky \
     -o "$out/relit"
 
+value() { tr ' ' '\n' <<< "$summary" | sed -n "s/^$1=//p"; }
+echo
+echo "gt-env on the demo's test views (novel views under novel lights):"
+printf '  shadowed PSNR %.2f dB, SSIM %.4f | unshadowed PSNR %.2f dB | albedo PSNR %.2f dB\n' \
+    "$(value shadowed_psnr)" "$(value shadowed_ssim)" "$(value unshadowed_psnr)" "$(value albedo_psnr)"
+printf '  normal error mean %.1f deg, median %.1f deg | sky pixels covered by surfels %.2f %%\n' \
+    "$(value normal_mean_deg)" "$(value normal_median_deg)" "$(awk -v s="$(value sky_alpha)" 'BEGIN { print 100 * s }')"
 echo
 echo "Done. Look at:"
 echo "  $out/scene/images/        the photos (one lighting each), with masks/ and sparse/0/"
