@@ -17,6 +17,11 @@
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/relight/camera_json.h"
+#include "lumigauss/relight/relit_sky.h"
+#include "lumigauss/shading/envmap.h"
+#include "lumigauss/shading/sh_text.h"
+#include "lumigauss/shading/sky_colour.h"
+#include "lumigauss/shading/sky_image.h"
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/train/trained_run.h"
 #include "lumigauss/train/view_shading.h"
@@ -124,6 +129,66 @@ TEST(CliRelight, EveryLightKindWritesEveryMapAtTheCameraSize) {
                       tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_THAT(r.output, HasSubstr("fake HDR boost"));
+}
+
+// --background sky: where nothing is drawn (alpha 0), an SH light shows its sky through the SH
+// (sky_colour.h), a panorama light the panorama itself along the pixel's ray (relit_sky.h); the surfels'
+// pixels (alpha 1) are the plain colour.
+TEST(CliRelight, SkyBackgroundShowsTheLightsSky) {
+    const TinyRun& t = tiny_run();
+    ASSERT_EQ(t.train.exit_code, 0) << t.train.output;
+    const Dataset scene = load_dataset(t.scene);
+    const View& view = *test_views(scene).front();
+    const std::string stem = fs::path(view.name).stem().string();
+    TempDir tmp("cli_relight_sky");
+    const std::string base = "render " + shell_quoted(t.run) + " --scene " + shell_quoted(t.scene) +
+                             " --view " + shell_quoted(view.name) + " --outputs shadowed,alpha ";
+    const std::string sh_file = t.scene + "/env/sky01_sh.txt", pano = t.scene + "/env/sky01.exr";
+    for (const auto& [name, light] :
+         {std::pair{"sh", sh_file}, std::pair{"pano", pano}, std::pair{"plain", sh_file}}) {
+        const std::string background = std::string(name) == "plain" ? "" : " --background sky";
+        const CommandResult r = run_lumigauss(
+            base + "--light " + shell_quoted(light) + background + " -o " + shell_quoted(tmp / name), tmp);
+        ASSERT_EQ(r.exit_code, 0) << r.output;
+    }
+    const auto load = [&](const char* name, const char* map) {
+        return read_image(tmp / name + "/" + stem + "_" + map + ".png");
+    };
+    const Image alpha = load("plain", "alpha"), plain = load("plain", "shadowed");
+    const Image with_sh = load("sh", "shadowed"), with_pano = load("pano", "shadowed");
+    const Image sh_sky = sky_image(view.camera, read_sh_text(sh_file).cast<float>());
+    const Image pano_pixels = read_image(pano);
+    int empty = 0, covered = 0;
+    for (int y = 0; y < alpha.height; ++y)
+        for (int x = 0; x < alpha.width; ++x) {
+            if (alpha.at(x, y, 0) == 0.0f) {
+                ++empty;
+                const Vec3d d = pixel_ray_direction(view.camera, x, y);
+                const EquirectCoord e = direction_to_equirect(d, pano_pixels.width, pano_pixels.height);
+                const Vec3d radiance = sample_equirect(pano_pixels, e.row, e.col);
+                for (int c = 0; c < 3; ++c) {
+                    EXPECT_NEAR(with_sh.at(x, y, c), sh_sky.at(x, y, c), 1.0 / 255);
+                    EXPECT_NEAR(with_pano.at(x, y, c), sky_channel(radiance[c]), 1.0 / 255);
+                }
+            } else {
+                // colour + (1 - alpha) sky, to the PNG's rounding (alpha and the colour are rounded too).
+                ++covered;
+                for (int c = 0; c < 3; ++c) {
+                    const double expected =
+                        plain.at(x, y, c) + (1.0 - alpha.at(x, y, 0)) * sh_sky.at(x, y, c);
+                    if (expected < 0.99) {
+                        EXPECT_NEAR(with_sh.at(x, y, c), expected, 3.0 / 255);
+                    }
+                }
+            }
+        }
+    EXPECT_GT(empty, 20) << "no empty pixel to see the sky in";
+    EXPECT_GT(covered, 20);
+    const CommandResult bad = run_lumigauss(
+        base + "--light " + shell_quoted(sh_file) + " --background blue -o " + shell_quoted(tmp / "bad"),
+        tmp);
+    EXPECT_NE(bad.exit_code, 0);
+    EXPECT_THAT(bad.output, HasSubstr("neither sky nor three numbers"));
 }
 
 TEST(CliRelight, PhotoLightRenderIsTheLibraryRender) {
