@@ -40,8 +40,11 @@ TEST(CliInfo, DescribesPlaza) {
     EXPECT_TRUE(contains(r.output, "views:         28 (train 24, test 4, validation 0)")) << r.output;
     EXPECT_TRUE(contains(r.output, "resolutions:   128x96 (28)")) << r.output;
     EXPECT_TRUE(contains(r.output, "camera models: PINHOLE (28)")) << r.output;
-    EXPECT_TRUE(contains(r.output, "masks:         28 of 28 views")) << r.output;
+    EXPECT_TRUE(contains(r.output, "masks:         28 of 28 views, taken as transient masks")) << r.output;
+    EXPECT_TRUE(contains(r.output, "sky masks:     28 of 28 views (255 = sky")) << r.output;
     EXPECT_TRUE(contains(r.output, "points:        4658")) << r.output;
+    const CommandResult object = run_lumigauss("info '" + plaza + "' --masks object", tmp);
+    EXPECT_TRUE(contains(object.output, "taken as object masks (0 = empty space")) << object.output;
     EXPECT_TRUE(contains(r.output, "camera centre: mean (")) << r.output;
     EXPECT_TRUE(contains(r.output, "points bbox:   min (")) << r.output;
 
@@ -58,6 +61,7 @@ TEST(CliInfo, SmallSceneExtent) {
     const CommandResult r = run_lumigauss("info '" + (tmp / "scene") + "'", tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_TRUE(contains(r.output, "mean (1, 0, -5), extent 1.1 ")) << r.output;
+    EXPECT_TRUE(contains(r.output, "sky masks:     0 of 3 views (the sky is then found")) << r.output;
     EXPECT_TRUE(contains(r.output, "min (-1, 0, 0), max (1, 2, 3)")) << r.output;
 }
 
