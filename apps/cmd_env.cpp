@@ -14,9 +14,9 @@
 #include <string>
 
 #include "commands.h"
+#include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/relight/light_source.h"
-#include "lumigauss/relight/up_axis.h"
 #include "lumigauss/shading/envmap.h"
 #include "lumigauss/shading/sh_text.h"
 #include "lumigauss/util/error.h"

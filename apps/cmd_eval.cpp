@@ -22,14 +22,15 @@
 #include "lumigauss/eval/sol_nerf.h"
 #include "lumigauss/eval/sol_nerf_report.h"
 #include "lumigauss/io/dataset.h"
-#include "lumigauss/train/trained_run.h"
+#include "lumigauss/model/trained_run.h"
+#include "lumigauss/render/rasterizer.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss::cli {
 namespace {
 
 struct EvalOptions {
-    std::string run, scene, protocol = "gt-env", out = "eval", views = "test";
+    std::string run, scene, protocol = "gt-env", out = "eval", views = "test", backend = "cpu";
     int downscale = 0;  // 0: the run's config.json downscale (1 if unknown)
     int threads = 0;
     bool no_sheets = false, quiet = false;
@@ -67,6 +68,7 @@ void run_gt_env(const EvalOptions& o) {
     GtEnvOptions gopt;
     gopt.views = o.views == "train" ? Split::Train : Split::Test;
     gopt.keep_panels = !o.no_sheets;
+    gopt.backend = choose_backend(o.backend);
     const GtEnvResult result = evaluate_gt_env(run, scene, meta, gopt);
     write_gt_env_report(o.out, result, {o.run, o.scene}, !o.no_sheets);
     const double s = seconds_since(t0);
@@ -159,6 +161,7 @@ void run_sol_nerf(const EvalOptions& o) {
                     config.path.c_str(), o.angles > 0 ? o.angles : config.angles);
     SolNerfOptions sopt;
     sopt.keep_panels = !o.no_sheets;
+    sopt.backend = choose_backend(o.backend);
     sopt.angles = o.angles;
     sopt.roots = {o.scene, o.env_root, o.mask_root};
     const SolNerfResult result = evaluate_sol_nerf(run.model, scene, config, sopt);
@@ -185,6 +188,7 @@ void run_holdout(const EvalOptions& o) {
     HoldoutOptions hopt;
     hopt.views = o.views == "train" ? Split::Train : Split::Test;
     hopt.keep_panels = !o.no_sheets;
+    hopt.backend = choose_backend(o.backend);
     const bool has_network = run.lighting.num_images() > 0;
     hopt.fit.variable =
         o.via == "sh" || (o.via == "auto" && !has_network) ? LightVariable::Sh : LightVariable::Embedding;
@@ -265,6 +269,11 @@ void register_eval(CLI::App& app) {
         ->check(CLI::IsMember({"test", "train"}))
         ->capture_default_str();
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)");
+    cmd->add_option("--backend", o->backend,
+                    "rasterize the scored renders on the CPU or on the GPU (cuda: builds with the CUDA "
+                    "backend, on a machine with a GPU; auto: the GPU when there is one)")
+        ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
+        ->capture_default_str();
     cmd->add_flag("--no-sheets", o->no_sheets, "skip the contact sheets");
     cmd->add_flag("-q,--quiet", o->quiet, "print only the final line");
     const std::string sol = "sol-nerf";

@@ -12,14 +12,14 @@
 #include <memory>
 
 #include "commands.h"
+#include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/export/baked_colours.h"
 #include "lumigauss/export/environment_files.h"
 #include "lumigauss/export/ply_3dgs.h"
 #include "lumigauss/export/relightable_bundle.h"
 #include "lumigauss/export/splat_format.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_source.h"
-#include "lumigauss/relight/up_axis.h"
-#include "lumigauss/train/trained_run.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss::cli {

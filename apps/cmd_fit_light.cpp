@@ -11,13 +11,13 @@
 #include <memory>
 
 #include "commands.h"
+#include "lumigauss/cameras/camera_json.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
-#include "lumigauss/relight/camera_json.h"
+#include "lumigauss/model/render_model.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_fit.h"
 #include "lumigauss/shading/sh_text.h"
-#include "lumigauss/train/trained_run.h"
-#include "lumigauss/train/view_shading.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss::cli {

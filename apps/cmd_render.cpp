@@ -16,11 +16,10 @@
 #include "commands.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
+#include "lumigauss/model/splat_ply.h"
 #include "lumigauss/relight/relight_job.h"
-#include "lumigauss/render/cpu/rasterizer_cpu.h"
-#include "lumigauss/render/cuda/rasterizer_cuda.h"
 #include "lumigauss/render/raster_maps.h"
-#include "lumigauss/scene/splat_ply.h"
+#include "lumigauss/render/rasterizer.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss::cli {
@@ -55,7 +54,7 @@ void write_extra_maps(const RenderOptions& o, const View& v, const RasterImages<
     write_png(output_path(o.out, v.name, "_normal.png").string(), encode_normals(img));
 }
 
-void run_relight(const RenderOptions& o) {
+void run_relight(const RenderOptions& o, RasterBackend backend) {
     if (o.extra_maps) throw Error("--maps is for --ply; a run's maps are chosen with --outputs");
     if (o.split_given) throw Error("--split is for --ply; a run's cameras are chosen with --cameras");
     RelightJob job = o.job;
@@ -69,6 +68,7 @@ void run_relight(const RenderOptions& o) {
     job.outputs.background = {o.background[0], o.background[1], o.background[2]};
     job.outputs.sky_background = o.sky_background;
     job.video = !o.no_video;
+    job.backend = backend;
     const auto t0 = std::chrono::steady_clock::now();
     const RelightSummary summary = run_relight_job(job, [&](const std::string& line) {
         if (!o.quiet) std::printf("%s\n", line.c_str());
@@ -108,10 +108,8 @@ void run_render(RenderOptions o) {
     if (o.background.size() != 3) throw Error("--background needs three values R,G,B");
     if (o.run.empty() == o.ply.empty())
         throw Error("render: give either a training run folder (render RUN --light L) or --ply FILE");
-    if (!o.run.empty()) {
-        if (o.backend != "cpu") throw Error("--backend is for --ply; a run renders on the CPU");
-        return run_relight(o);
-    }
+    const RasterBackend backend = choose_backend(o.backend);
+    if (!o.run.empty()) return run_relight(o, backend);
     if (o.scene.empty()) throw Error("render --ply needs --scene (the cameras to render from)");
     DatasetOptions dopt;
     dopt.downscale = o.downscale > 0 ? o.downscale : 1;
@@ -122,21 +120,15 @@ void run_render(RenderOptions o) {
     RasterSettings<float> settings;
     settings.background = o.background;
     int done = 0;
-    RasterState<float> state;  // reused: its buffers and the images' keep their memory from view to view
+    // Reused: its buffers and the images' keep their memory from view to view.
+    const std::unique_ptr<Rasterizer> rasterizer = make_rasterizer(backend);
     RasterImages<float> img;
-    std::unique_ptr<CudaRasterizer> gpu;  // says why when this build or machine has no GPU backend
-    if (o.backend == "cuda") {
-        gpu = std::make_unique<CudaRasterizer>();
-        std::printf("render: on %s\n", cuda_backend_description().c_str());
-    }
+    if (backend != RasterBackend::Cpu) std::printf("render: on %s\n", backend_description(backend).c_str());
     for (const View& v : scene.views) {
         if (o.split != "all" && o.split != split_name(v.split)) continue;
         const auto t0 = std::chrono::steady_clock::now();
         colors_for_view(model, v.camera.center());
-        if (gpu)
-            gpu->forward(v.camera, model.surfels, settings, img);
-        else
-            rasterize_forward_cpu(v.camera, model.surfels, settings, state, img);
+        rasterizer->forward(v.camera, model.surfels, settings, img);
         const auto path = output_path(o.out, v.name, ".png");
         std::filesystem::create_directories(path.parent_path());
         write_png(path.string(), raster_channels(img, 0, 3));
@@ -144,7 +136,7 @@ void run_render(RenderOptions o) {
         const double ms =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         std::printf("  [%d] %s  %dx%d  %zu intersections  %.1f ms\n", ++done, path.string().c_str(),
-                    v.camera.width, v.camera.height, gpu ? gpu->intersections() : state.intersections(), ms);
+                    v.camera.width, v.camera.height, rasterizer->intersections(), ms);
     }
     if (done == 0) throw Error("no view of " + o.scene + " is in split '" + o.split + "'");
     std::printf("render: wrote %d images to %s\n", done, o.out.c_str());
@@ -179,9 +171,9 @@ void register_render(CLI::App& app) {
                     "R,G,B in [0,1] (composited under colour and albedo using alpha); default black");
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)");
     cmd->add_option("--backend", o->backend,
-                    "--ply: rasterize on the CPU or on the GPU (cuda: builds with the CUDA backend, on a "
-                    "machine with a GPU)")
-        ->check(CLI::IsMember({"cpu", "cuda"}))
+                    "rasterize on the CPU or on the GPU (cuda: builds with the CUDA backend, on a machine "
+                    "with a GPU; auto: the GPU when there is one)")
+        ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
         ->capture_default_str();
     cmd->add_flag("--maps", o->extra_maps,
                   "--ply: also write alpha (PNG), expected depth (EXR) and world normals (PNG)");

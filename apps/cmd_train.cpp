@@ -20,8 +20,10 @@
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/io/text_file.h"
+#include "lumigauss/model/render_model.h"
 #include "lumigauss/render/background.h"
 #include "lumigauss/render/raster_maps.h"
+#include "lumigauss/render/rasterizer.h"
 #include "lumigauss/shading/sky_image.h"
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/train/checkpoint.h"
@@ -38,7 +40,7 @@ extern "C" void on_interrupt(int) {
 }
 
 struct TrainFlags {
-    std::string scene, out, preset = "default", config_file;
+    std::string scene, out, preset = "default", config_file, backend = "cpu";
     std::vector<std::string> overrides;
     std::int64_t iterations = 0, stop_after = 0;
     int downscale = 0, threads = 0;
@@ -162,6 +164,7 @@ void checkpoint(const RunPaths& paths, const TrainState& state) {
 }
 
 int run_train(const TrainFlags& f) {
+    const RasterBackend backend = choose_backend(f.backend);  // before anything is read or written
     std::unique_ptr<tbb::global_control> threads;
     if (f.threads > 0)
         threads =
@@ -205,6 +208,9 @@ int run_train(const TrainFlags& f) {
                     (long long)config.iterations, f.out.c_str());
         std::fflush(stdout);
     }
+    trainer->set_backend(backend);
+    if (backend != RasterBackend::Cpu && !f.quiet)
+        std::printf("train: rasterizing on %s\n", backend_description(backend).c_str());
     const TrainConfig& config = trainer->state().config;
     std::signal(SIGINT, on_interrupt);
     std::signal(SIGTERM, on_interrupt);
@@ -291,6 +297,12 @@ void register_train(CLI::App& app) {
         ->check(CLI::PositiveNumber);
     cmd->add_option("--threads", f->threads, "Worker threads (default: all cores)")
         ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--backend", f->backend,
+                    "Rasterize (forward and backward) on the CPU or on the GPU (cuda: builds with the CUDA "
+                    "backend, on a machine with a GPU; auto: the GPU when there is one); the rest of each "
+                    "iteration runs on the CPU")
+        ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
+        ->capture_default_str();
     cmd->add_flag("-q,--quiet", f->quiet, "No progress line");
     cmd->callback([f] {
         const int rc = run_train(*f);

@@ -8,11 +8,11 @@
 #include <optional>
 
 #include "commands.h"
+#include "lumigauss/cameras/camera_json.h"
+#include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/io/dataset.h"
-#include "lumigauss/relight/camera_json.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_source.h"
-#include "lumigauss/relight/up_axis.h"
-#include "lumigauss/train/trained_run.h"
 #include "lumigauss/util/error.h"
 #include "lumigauss/view/http_server.h"
 #include "lumigauss/view/model_payload.h"

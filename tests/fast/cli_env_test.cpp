@@ -9,8 +9,8 @@
 #include <numbers>
 #include <string>
 
+#include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/io/image.h"
-#include "lumigauss/relight/up_axis.h"
 #include "lumigauss/shading/sh_text.h"
 #include "support/run_cli.h"
 

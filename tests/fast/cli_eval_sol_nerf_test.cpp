@@ -12,7 +12,7 @@
 #include <string>
 
 #include "lumigauss/io/image.h"
-#include "lumigauss/scene/relightable_ply.h"
+#include "lumigauss/model/relightable_ply.h"
 #include "lumigauss/shading/sh_text.h"
 #include "support/run_cli.h"
 #include "support/sol_nerf_scene.h"

@@ -9,8 +9,8 @@
 #include <string>
 
 #include "lumigauss/export/relightable_bundle.h"
-#include "lumigauss/scene/relightable_ply.h"
-#include "lumigauss/scene/splat_ply.h"
+#include "lumigauss/model/relightable_ply.h"
+#include "lumigauss/model/splat_ply.h"
 #include "lumigauss/train/run_folder.h"
 #include "support/run_cli.h"
 #include "synth_test_util.h"

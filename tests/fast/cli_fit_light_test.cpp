@@ -8,13 +8,13 @@
 #include <filesystem>
 #include <string>
 
-#include "lumigauss/eval/metrics.h"
+#include "lumigauss/cameras/camera_json.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
-#include "lumigauss/relight/camera_json.h"
+#include "lumigauss/io/image_metrics.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_fit.h"
 #include "lumigauss/shading/sh_text.h"
-#include "lumigauss/train/trained_run.h"
 #include "support/clamped_render.h"
 #include "support/run_cli.h"
 #include "synth_test_util.h"

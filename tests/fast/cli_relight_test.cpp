@@ -14,17 +14,17 @@
 #include <string>
 #include <vector>
 
+#include "lumigauss/cameras/camera_json.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
-#include "lumigauss/relight/camera_json.h"
+#include "lumigauss/model/render_model.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/relit_sky.h"
 #include "lumigauss/shading/envmap.h"
 #include "lumigauss/shading/sh_text.h"
 #include "lumigauss/shading/sky_colour.h"
 #include "lumigauss/shading/sky_image.h"
 #include "lumigauss/shading/surfel_shading.h"
-#include "lumigauss/train/trained_run.h"
-#include "lumigauss/train/view_shading.h"
 #include "support/run_cli.h"
 #include "synth_test_util.h"
 

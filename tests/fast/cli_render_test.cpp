@@ -5,9 +5,9 @@
 
 #include "io_test_util.h"
 #include "lumigauss/io/dataset.h"
+#include "lumigauss/model/splat_ply.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/render/cuda/rasterizer_cuda.h"
-#include "lumigauss/scene/splat_ply.h"
 
 namespace lumigauss {
 namespace {

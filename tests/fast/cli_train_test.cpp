@@ -15,9 +15,10 @@
 #include <vector>
 
 #include "lumigauss/io/dataset.h"
-#include "lumigauss/scene/relightable_ply.h"
+#include "lumigauss/model/lighting_mlp.h"
+#include "lumigauss/model/relightable_ply.h"
+#include "lumigauss/render/rasterizer.h"
 #include "lumigauss/train/checkpoint.h"
-#include "lumigauss/train/lighting_mlp.h"
 #include "lumigauss/train/run_folder.h"
 #include "support/run_cli.h"
 #include "synth_test_util.h"
@@ -142,7 +143,7 @@ TEST(CliTrain, ShortRunWritesEveryRunFile) {
     std::vector<std::string> train_names;
     for (const View* v : scene.split(Split::Train)) train_names.push_back(v->name);
     EXPECT_EQ(load_appearance(run + "/appearance.json"), train_names);
-    const GaussianModel model = load_relightable_ply(run + "/model.ply");
+    const SurfelModel model = load_relightable_ply(run + "/model.ply");
     EXPECT_EQ(model.size(), log.back()["surfels"].get<std::size_t>());
     EXPECT_GT(model.size(), 0u);
     EXPECT_EQ(load_lighting_mlp(run + "/lighting.lgmlp").num_images(), int(train_names.size()));
@@ -222,6 +223,25 @@ TEST(CliTrain, ExistingRunNeedsResumeOrForce) {
     EXPECT_EQ(load_checkpoint(run + "/checkpoint.lgck").iteration, 30);
     EXPECT_EQ(log_iterations(read_log(run + "/log.jsonl")),
               (std::vector<std::int64_t>{5, 10, 15, 20, 25, 30}));
+}
+
+// --backend: the rasterizer's backend. auto trains on the CPU where there is no GPU, bit for bit as the
+// default; cuda without the CUDA backend is refused before anything is read or written, saying why.
+TEST(CliTrain, BackendAutoIsTheCpuWithoutAGpuAndCudaIsRefused) {
+    if (choose_backend("auto") == RasterBackend::Cuda) GTEST_SKIP() << "this machine has the CUDA backend";
+    TempDir tmp("cli_train_backend");
+    const std::string short_run = " --preset fast --iterations 12 --set log_interval=4 -q";
+    ASSERT_EQ(run_lumigauss(train_args(tmp / "cpu", short_run), tmp).exit_code, 0);
+    const CommandResult automatic =
+        run_lumigauss(train_args(tmp / "auto", short_run + " --backend auto"), tmp);
+    ASSERT_EQ(automatic.exit_code, 0) << automatic.output;
+    EXPECT_EQ(synth_test::read_bytes(tmp / "auto/model.ply"), synth_test::read_bytes(tmp / "cpu/model.ply"));
+
+    const CommandResult cuda = run_lumigauss(train_args(tmp / "cuda", short_run + " --backend cuda"), tmp);
+    EXPECT_NE(cuda.exit_code, 0);
+    EXPECT_THAT(cuda.output, HasSubstr("--backend cuda"));
+    EXPECT_THAT(cuda.output, HasSubstr("CUDA"));
+    EXPECT_FALSE(std::filesystem::exists(tmp / "cuda")) << "a refused run wrote its folder";
 }
 
 // ---- 10. Bad input

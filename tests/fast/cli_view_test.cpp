@@ -27,11 +27,11 @@
 #include <thread>
 #include <vector>
 
-#include "lumigauss/relight/camera_json.h"
+#include "lumigauss/cameras/camera_json.h"
+#include "lumigauss/cameras/up_axis.h"
+#include "lumigauss/model/relightable_ply.h"
 #include "lumigauss/relight/relit_render.h"
-#include "lumigauss/relight/up_axis.h"
 #include "lumigauss/render/raster_maps.h"
-#include "lumigauss/scene/relightable_ply.h"
 #include "lumigauss/shading/sh_text.h"
 #include "relight_test_util.h"
 #include "support/random_surfels.h"
@@ -249,7 +249,7 @@ std::vector<unsigned char> base64_decode(const std::string& text) {
 }
 
 // The C++ image of each view, as relit_outputs.h writes it (3 channels, clamped to [0, 1]).
-std::map<std::string, Image> cpu_views(const GaussianModel& model, const Camera& cam,
+std::map<std::string, Image> cpu_views(const SurfelModel& model, const Camera& cam,
                                        const ShCoeffs<float>& env) {
     RelitRenderer renderer(model);
     const RasterImages<float>& raster = renderer.render(cam, env);

@@ -14,10 +14,10 @@
 #include "lumigauss/eval/gt_env.h"
 #include "lumigauss/eval/report.h"
 #include "lumigauss/io/dataset.h"
-#include "lumigauss/scene/relightable_ply.h"
+#include "lumigauss/model/lighting_mlp.h"
+#include "lumigauss/model/relightable_ply.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/sh_text.h"
-#include "lumigauss/train/lighting_mlp.h"
 #include "lumigauss/util/error.h"
 #include "synth_test_util.h"
 

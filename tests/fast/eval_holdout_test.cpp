@@ -10,7 +10,7 @@
 #include "lumigauss/eval/holdout.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
-#include "lumigauss/train/trained_run.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/util/error.h"
 #include "support/clamped_render.h"
 #include "support/run_cli.h"

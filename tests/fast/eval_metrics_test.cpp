@@ -1,4 +1,4 @@
-// Image metrics of the evaluation (eval/metrics.h) against known answers: identical images, a constant
+// Image metrics of the evaluation (io/image_metrics.h) against known answers: identical images, a constant
 // offset, closed-form SSIM cases, an independent direct evaluation of the skimage SSIM formula, masks,
 // erosion, normal angles and the per-channel scale.
 #include <gtest/gtest.h>
@@ -7,7 +7,7 @@
 #include <random>
 #include <vector>
 
-#include "lumigauss/eval/metrics.h"
+#include "lumigauss/io/image_metrics.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {

@@ -9,9 +9,9 @@
 #include "lumigauss/export/environment_files.h"
 #include "lumigauss/export/relightable_bundle.h"
 #include "lumigauss/io/image.h"
-#include "lumigauss/scene/relightable_ply.h"
+#include "lumigauss/model/relightable_ply.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/shading/sh_text.h"
-#include "lumigauss/train/trained_run.h"
 #include "lumigauss/util/error.h"
 #include "relight_test_util.h"
 #include "support/random_surfels.h"
@@ -44,7 +44,7 @@ TEST(ExportBundle, RelightablePlyAndSidecarRoundTrip) {
     EXPECT_EQ(sidecar, tmp / "out/model_relightable.environments.json");
     EXPECT_EQ(relightable_sidecar_path("x/y.PLY"), "x/y.environments.json");
 
-    const GaussianModel back = load_relightable_ply(ply);
+    const SurfelModel back = load_relightable_ply(ply);
     ASSERT_EQ(back.size(), run.model.size());
     for (int p = 0; p < kModelParamCount; ++p)
         EXPECT_EQ(back.param(ModelParam(p)), run.model.param(ModelParam(p)))

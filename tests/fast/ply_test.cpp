@@ -7,8 +7,8 @@
 
 #include "io_test_util.h"
 #include "lumigauss/io/ply.h"
-#include "lumigauss/scene/splat_ply.h"
-#include "lumigauss/scene/view_sh.h"
+#include "lumigauss/model/splat_ply.h"
+#include "lumigauss/model/view_sh.h"
 
 namespace lumigauss {
 namespace {

@@ -1,4 +1,4 @@
-// The frozen-geometry compositor (render/cpu/blend_weights.h): its weights reproduce the rasterizer's colour
+// The frozen-geometry compositor (render/blend_weights.h): its weights reproduce the rasterizer's colour
 // image for any colours, its backward is the rasterizer's colour gradient, and the pairs stop where the
 // forward stopped (alpha clamp, 1/255 skip, transmittance stop).
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "lumigauss/render/cpu/blend_weights.h"
+#include "lumigauss/render/cpu/blend_weights_cpu.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "support/random_surfels.h"
 

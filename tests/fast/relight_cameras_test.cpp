@@ -9,9 +9,9 @@
 #include <functional>
 #include <numbers>
 
-#include "lumigauss/relight/camera_json.h"
-#include "lumigauss/relight/orbit.h"
-#include "lumigauss/relight/up_axis.h"
+#include "lumigauss/cameras/camera_json.h"
+#include "lumigauss/cameras/orbit.h"
+#include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/util/error.h"
 #include "support/temp_dir.h"
 

@@ -8,8 +8,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "lumigauss/model/view_shading.h"
 #include "lumigauss/relight/light_fit.h"
-#include "lumigauss/train/view_shading.h"
 #include "lumigauss/util/error.h"
 #include "relight_test_util.h"
 #include "support/clamped_render.h"
@@ -29,8 +29,7 @@ ShCoeffs<double> true_light(std::uint64_t seed) {
     return sh;
 }
 
-Image render_photo(const GaussianModel& model, const Camera& cam, const ShCoeffs<double>& env,
-                   bool shadowed) {
+Image render_photo(const SurfelModel& model, const Camera& cam, const ShCoeffs<double>& env, bool shadowed) {
     return testing::clamped_render(model, cam, env,
                                    shadowed ? ShadingMode::Shadowed : ShadingMode::Unshadowed);
 }
@@ -48,7 +47,7 @@ double relative_error(const ShCoeffs<double>& a, const ShCoeffs<double>& b) {
 
 // What one photo determines: the colour of every surfel under the light (the transfer or the irradiance of
 // its camera-facing normal, times its albedo). Relative RMS difference of those colours under a and b.
-double shading_error(const GaussianModel& model, const Camera& cam, const ShCoeffs<double>& a,
+double shading_error(const SurfelModel& model, const Camera& cam, const ShCoeffs<double>& a,
                      const ShCoeffs<double>& b, bool shadowed) {
     ViewNormals normals;
     compute_view_normals(model, cam, normals);

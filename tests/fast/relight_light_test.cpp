@@ -11,9 +11,9 @@
 #include <functional>
 #include <numbers>
 
+#include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/relight/light_source.h"
-#include "lumigauss/relight/up_axis.h"
 #include "lumigauss/shading/envmap.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/sh_rotation.h"

@@ -7,14 +7,14 @@
 #include <cmath>
 #include <numbers>
 
+#include "lumigauss/cameras/up_axis.h"
+#include "lumigauss/model/render_model.h"
 #include "lumigauss/relight/light_source.h"
 #include "lumigauss/relight/relit_render.h"
-#include "lumigauss/relight/up_axis.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/sh_rotation.h"
 #include "lumigauss/shading/sh_text.h"
 #include "lumigauss/shading/surfel_shading.h"
-#include "lumigauss/train/view_shading.h"
 #include "relight_test_util.h"
 #include "support/random_surfels.h"
 #include "support/temp_dir.h"

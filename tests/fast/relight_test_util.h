@@ -8,9 +8,9 @@
 
 #include "lumigauss/io/camera.h"
 #include "lumigauss/math/quaternion.h"
-#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/shading/sh.h"
-#include "lumigauss/train/trained_run.h"
+#include "lumigauss/train/gaussian_model.h"
 
 namespace lumigauss::relight_test {
 
@@ -54,7 +54,7 @@ inline GaussianModel random_model(const Camera& cam, std::uint64_t seed, std::si
 }
 
 // A run held in memory: the model, a seeded lighting MLP with one embedding per name.
-inline TrainedRun in_memory_run(GaussianModel model, const std::vector<std::string>& names,
+inline TrainedRun in_memory_run(SurfelModel model, const std::vector<std::string>& names,
                                 std::uint32_t seed = 7) {
     TrainedRun run;
     run.dir = "memory-run";

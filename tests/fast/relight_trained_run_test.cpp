@@ -1,4 +1,4 @@
-// load_trained_run (train/trained_run.h), shared by `render RUN` and `eval`: reads what a run folder holds,
+// load_trained_run (model/trained_run.h), shared by `render RUN` and `eval`: reads what a run folder holds,
 // gives lighting.env_sh(i) per photo, and names the missing or inconsistent file.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -7,8 +7,8 @@
 #include <fstream>
 #include <functional>
 
-#include "lumigauss/scene/relightable_ply.h"
-#include "lumigauss/train/trained_run.h"
+#include "lumigauss/model/relightable_ply.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/util/error.h"
 #include "relight_test_util.h"
 #include "support/random_surfels.h"

@@ -12,10 +12,10 @@
 
 #include "lumigauss/io/ply.h"
 #include "lumigauss/math/quaternion.h"
-#include "lumigauss/scene/gaussian_model.h"
-#include "lumigauss/scene/knn.h"
-#include "lumigauss/scene/relightable_ply.h"
+#include "lumigauss/model/knn.h"
+#include "lumigauss/model/relightable_ply.h"
 #include "lumigauss/shading/sh.h"
+#include "lumigauss/train/gaussian_model.h"
 
 namespace lumigauss {
 namespace {
@@ -320,7 +320,7 @@ TEST(SceneModelPly, OfficialLayoutRoundTrip) {
     EXPECT_EQ(t.names[66], "rot_0");
     // Channel-major rest: f_rest_positive_8 is channel 1 (G) of coefficient 1, stored at [1 * 3 + 1].
     EXPECT_EQ(t.column("f_rest_positive_8", path)[2], m.param(ModelParam::TransferPositive)[2 * 27 + 4]);
-    const GaussianModel back = load_relightable_ply(path);
+    const SurfelModel back = load_relightable_ply(path);
     for (int p = 0; p < kModelParamCount; ++p)
         EXPECT_EQ(back.param(ModelParam(p)), m.param(ModelParam(p))) << GaussianModel::name(ModelParam(p));
     std::filesystem::remove(path);

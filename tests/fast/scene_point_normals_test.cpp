@@ -6,9 +6,9 @@
 #include <random>
 
 #include "lumigauss/math/quaternion.h"
-#include "lumigauss/scene/gaussian_model.h"
-#include "lumigauss/scene/knn.h"
-#include "lumigauss/scene/point_normals.h"
+#include "lumigauss/model/knn.h"
+#include "lumigauss/model/point_normals.h"
+#include "lumigauss/train/gaussian_model.h"
 
 namespace lumigauss {
 namespace {

@@ -13,10 +13,10 @@
 
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
+#include "lumigauss/model/render_model.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/synth/synth.h"
 #include "lumigauss/train/trainer.h"
-#include "lumigauss/train/view_shading.h"
 #include "synth_test_util.h"
 
 namespace lumigauss {

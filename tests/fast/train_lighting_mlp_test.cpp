@@ -8,7 +8,7 @@
 #include <iterator>
 #include <random>
 
-#include "lumigauss/train/lighting_mlp.h"
+#include "lumigauss/model/lighting_mlp.h"
 #include "lumigauss/util/error.h"
 #include "support/temp_dir.h"
 

@@ -16,12 +16,12 @@
 #include <utility>
 #include <vector>
 
-#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/model/view_shading.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/sh.h"
 #include "lumigauss/shading/surfel_shading.h"
+#include "lumigauss/train/gaussian_model.h"
 #include "lumigauss/train/physical_losses.h"
-#include "lumigauss/train/view_shading.h"
 #include "support/finite_difference.h"
 
 namespace lumigauss {

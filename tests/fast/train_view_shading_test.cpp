@@ -15,11 +15,12 @@
 #include <vector>
 
 #include "lumigauss/math/quaternion.h"
-#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/model/render_model.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/sh.h"
 #include "lumigauss/shading/surfel_shading.h"
-#include "lumigauss/train/view_shading.h"
+#include "lumigauss/train/gaussian_model.h"
+#include "lumigauss/train/view_shading_backward.h"
 #include "lumigauss/util/error.h"
 #include "support/finite_difference.h"
 #include "support/random_surfels.h"

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "lumigauss/relight/up_axis.h"
+#include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/util/error.h"
 #include "lumigauss/view/model_payload.h"
@@ -81,7 +81,7 @@ TEST(ViewModelPayload, DecodesBackToTheModelExactly) {
     for (bool positive : {true, false}) {
         std::vector<float> want(57 * 9);
         for (std::size_t i = 0; i < 57; ++i) model.transfer_channel0(positive, i, &want[9 * i]);
-        // Channel 0 is [k * 3 + 0] of the stored 27 (scene/gaussian_model.h).
+        // Channel 0 is [k * 3 + 0] of the stored 27 (model/surfel_model.h).
         const auto& raw = model.param(positive ? ModelParam::TransferPositive : ModelParam::TransferNegative);
         EXPECT_EQ(want[9 * 5 + 4], raw[5 * 27 + 4 * 3]);
         expect_bits(positive ? d.positive : d.negative, want, positive ? "transfer+" : "transfer-");

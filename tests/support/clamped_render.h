@@ -4,11 +4,11 @@
 #include <algorithm>
 
 #include "lumigauss/io/image.h"
-#include "lumigauss/train/view_shading.h"
+#include "lumigauss/model/render_model.h"
 
 namespace lumigauss::testing {
 
-inline Image clamped_render(const GaussianModel& model, const Camera& camera, const ShCoeffs<double>& light,
+inline Image clamped_render(const SurfelModel& model, const Camera& camera, const ShCoeffs<double>& light,
                             ShadingMode mode = ShadingMode::Shadowed) {
     const RasterImages<float> img = render_with_environment(model, camera, light.cast<float>(), mode);
     Image out(camera.width, camera.height, 3);

@@ -20,9 +20,9 @@
 #include "lumigauss/eval/sol_nerf.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/math/quaternion.h"
-#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/model/render_model.h"
 #include "lumigauss/shading/irradiance.h"
-#include "lumigauss/train/view_shading.h"
+#include "lumigauss/train/gaussian_model.h"
 
 namespace lumigauss::testing {
 

@@ -10,13 +10,13 @@
 
 #include "lumigauss/io/text_file.h"
 #include "lumigauss/math/quaternion.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/relit_render.h"
 #include "lumigauss/render/raster_maps.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/sh_text.h"
 #include "lumigauss/shading/sky_image.h"
 #include "lumigauss/shading/surfel_shading.h"
-#include "lumigauss/train/trained_run.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {
@@ -157,7 +157,7 @@ RelightableRun load_relightable_run(const std::string& dir) {
     return run;
 }
 
-GaussianModel relightable_from_surfels(const ViewDependentSurfels& s) {
+SurfelModel relightable_from_surfels(const ViewDependentSurfels& s) {
     const std::size_t n = s.size();
     const std::size_t coeffs = std::size_t((s.sh_degree + 1) * (s.sh_degree + 1));
     if (s.sh.size() != n * coeffs * 3) throw Error("relightable_from_surfels: SH array of the wrong size");
@@ -186,7 +186,7 @@ GaussianModel relightable_from_surfels(const ViewDependentSurfels& s) {
                 raw[int(ModelParam::TransferNegative)].push_back(neg[k]);
             }
     }
-    return GaussianModel::from_raw(std::move(raw), 1.0);
+    return SurfelModel::from_raw(std::move(raw));
 }
 
 // ---- Light scale ----------------------------------------------------------------------------------------
@@ -263,7 +263,7 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
     result.light = fit_run_light_scale(run, meta, test_names);
 
     // One pass per view gives both colours, both intensities and the albedo (relight/relit_render.h).
-    RelitRenderer renderer(run.model);
+    RelitRenderer renderer(run.model, options.backend);
 
     std::vector<AlbedoInputs> albedo_inputs;
     std::vector<double> pooled_angles;

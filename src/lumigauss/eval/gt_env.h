@@ -17,7 +17,7 @@
 //    search, no per-image colour fit. Using the test photo's exposure is allowed: it is the camera's setting
 //    (recorded with the photo, like EXIF), not a property of the lighting; the data sets fix it to 1.0 for
 //    test photos anyway.
-// 3. Image metrics (eval/metrics.h, official formulas) of the render clamped to [0, 1] against the photo,
+// 3. Image metrics (io/image_metrics.h, official formulas) of the render clamped to [0, 1] against the photo,
 //    shadowed and unshadowed, under the evaluation mask: gt/mask (geometry coverage) eroded once with 5x5
 //    and kept where fully covered, times the scene's own mask (masks/, binarised at 0.5) if it has one.
 //    Without gt/mask the scene's mask alone is eroded and binarised the same way.
@@ -39,10 +39,11 @@
 #include <string>
 #include <vector>
 
-#include "lumigauss/eval/metrics.h"
 #include "lumigauss/io/dataset.h"
-#include "lumigauss/scene/gaussian_model.h"
-#include "lumigauss/scene/splat_ply.h"
+#include "lumigauss/io/image_metrics.h"
+#include "lumigauss/model/splat_ply.h"
+#include "lumigauss/model/surfel_model.h"
+#include "lumigauss/render/rasterizer.h"
 #include "lumigauss/shading/sh.h"
 
 namespace lumigauss {
@@ -74,7 +75,7 @@ ShCoeffs<double> load_condition_sh(const GtSceneMeta& meta, const std::string& c
 
 struct RelightableRun {
     std::string dir;
-    GaussianModel model;
+    SurfelModel model;
     std::vector<std::string> image_names;      // appearance.json, in embedding order
     std::vector<ShCoeffs<double>> learned_sh;  // the lighting MLP's env_sh(i) of each of them
     int downscale = 0;                         // config.json "downscale"; 0 if unknown
@@ -89,7 +90,7 @@ RelightableRun load_relightable_run(const std::string& dir);
 // is the linear albedo rho): model albedo = (rho / pi)^(1/2.2), so that with learned SH = exposure * true SH
 // (light scale 1) its unshadowed colour is (exposure rho/pi E)^(1/2.2), the photo up to the sRGB curve; both
 // transfer sets are the cosine lobes of their side's normal (unoccluded: shadowed == unshadowed).
-GaussianModel relightable_from_surfels(const ViewDependentSurfels& surfels);
+SurfelModel relightable_from_surfels(const ViewDependentSurfels& surfels);
 
 // ---- Light scale ----------------------------------------------------------------------------------------
 
@@ -173,6 +174,7 @@ struct GtEnvOptions {
     // that separates the lighting model from novel-view geometry: the training views, each rendered under its
     // own TRUE environment (not the learned one); the light scale is then fitted on all training photos.
     Split views = Split::Test;
+    RasterBackend backend = RasterBackend::Cpu;
 };
 
 // Runs the protocol on every test view of `scene` (loaded at the resolution to evaluate). Throws Error

@@ -110,7 +110,7 @@ HoldoutResult evaluate_holdout(const TrainedRun& run, const Dataset& scene, cons
     const std::vector<const View*> views = scene.split(options.views);
     if (views.empty())
         throw Error(scene.root + ": the scene has no " + split_name(options.views) + " image to evaluate");
-    RelitRenderer renderer(run.model);
+    RelitRenderer renderer(run.model, options.backend);
     std::vector<double> fit_ms, render_ms;
     for (const View* v : views) {
         result.images.push_back(evaluate_view(run, scene, *v, renderer, options));

@@ -6,7 +6,8 @@
 // under a light the model could explain, without any ground-truth environment.
 //
 //   fit mask    the scene's mask (soft values as stored; all ones without one) on columns x < W/2
-//   score mask  official_eval_mask (eval/metrics.h: 5x5 erosion, fully covered pixels) of the scene's mask
+//   score mask  official_eval_mask (io/image_metrics.h: 5x5 erosion, fully covered pixels) of the scene's
+//   mask
 //               binarised at 0.5, on columns x >= W/2
 // Each render is scored under its own fit: the shadowed render under the light fitted to the shadowed render,
 // the unshadowed one under the light fitted to the unshadowed render, so that neither is judged with a
@@ -15,12 +16,13 @@
 #include <vector>
 
 #include "lumigauss/eval/gt_env.h"
-#include "lumigauss/eval/metrics.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
+#include "lumigauss/io/image_metrics.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_fit.h"
+#include "lumigauss/render/rasterizer.h"
 #include "lumigauss/shading/sh.h"
-#include "lumigauss/train/trained_run.h"
 
 namespace lumigauss {
 
@@ -29,6 +31,7 @@ struct HoldoutOptions {
     SsimOptions ssim;     // win 5, as the official evaluation
     Split views = Split::Test;
     bool keep_panels = true;
+    RasterBackend backend = RasterBackend::Cpu;  // the scoring renders (the fits run on the CPU)
 };
 
 struct HoldoutImageResult {

@@ -10,10 +10,14 @@
 
 namespace lumigauss {
 
-MultiLightRenderer::MultiLightRenderer(const GaussianModel& model) : model_(model) {}
+MultiLightRenderer::MultiLightRenderer(const SurfelModel& model, RasterBackend backend)
+    : model_(model), renderer_(backend) {}
 
-void MultiLightRenderer::shade_pass(std::span<const ShCoeffs<float>> envs) {
+void MultiLightRenderer::shade_pass(std::span<const ShCoeffs<float>> envs, const ViewNormals& normals,
+                                    SurfelBatch<float>& batch) const {
     const std::size_t n = model_.size(), ch = 3 * envs.size();
+    batch.channels = int(ch);
+    batch.colors.resize(n * ch);
     const auto& albedo = model_.param(ModelParam::Albedo);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
         float pos[kTransferCoeffs], neg[kTransferCoeffs];
@@ -21,10 +25,10 @@ void MultiLightRenderer::shade_pass(std::span<const ShCoeffs<float>> envs) {
             model_.transfer_channel0(true, i, pos);
             model_.transfer_channel0(false, i, neg);
             const Vec3f raw{albedo[3 * i], albedo[3 * i + 1], albedo[3 * i + 2]};
-            const bool positive = normals_.positive_side[i] != 0;
+            const bool positive = normals.positive_side[i] != 0;
             for (std::size_t k = 0; k < envs.size(); ++k) {
                 const Vec3f rgb = surfel_colour_shadowed(envs[k], raw, pos, neg, positive);
-                for (int c = 0; c < 3; ++c) batch_.colors[i * ch + 3 * k + std::size_t(c)] = rgb[c];
+                for (int c = 0; c < 3; ++c) batch.colors[i * ch + 3 * k + std::size_t(c)] = rgb[c];
             }
         }
     });
@@ -32,17 +36,15 @@ void MultiLightRenderer::shade_pass(std::span<const ShCoeffs<float>> envs) {
 
 std::vector<Image> MultiLightRenderer::render_shadowed(const Camera& camera,
                                                        std::span<const ShCoeffs<float>> envs) {
-    compute_view_normals(model_, camera, normals_);
     std::vector<Image> out;
     out.reserve(envs.size());
     for (std::size_t first = 0; first < envs.size(); first += kLightsPerPass) {
         const std::span<const ShCoeffs<float>> pass =
             envs.subspan(first, std::min<std::size_t>(kLightsPerPass, envs.size() - first));
-        batch_.channels = int(3 * pass.size());
-        model_.activated(batch_);  // geometry, and colours resized to this pass's channel count
-        shade_pass(pass);
-        rasterize_forward_cpu(camera, batch_, RasterSettings<float>{}, state_, images_);
-        for (std::size_t k = 0; k < pass.size(); ++k) out.push_back(raster_channels(images_, int(3 * k), 3));
+        const RasterImages<float>& images = renderer_.render(
+            model_, camera,
+            [&](const ViewNormals& normals, SurfelBatch<float>& batch) { shade_pass(pass, normals, batch); });
+        for (std::size_t k = 0; k < pass.size(); ++k) out.push_back(raster_channels(images, int(3 * k), 3));
     }
     return out;
 }

@@ -15,11 +15,9 @@
 
 #include "lumigauss/io/camera.h"
 #include "lumigauss/io/image.h"
-#include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/model/render_model.h"
 #include "lumigauss/render/raster_types.h"
-#include "lumigauss/scene/gaussian_model.h"
 #include "lumigauss/shading/sh.h"
-#include "lumigauss/train/view_shading.h"
 
 namespace lumigauss {
 
@@ -27,19 +25,17 @@ inline constexpr int kLightsPerPass = kMaxChannels / 3;  // 5 environments per r
 
 class MultiLightRenderer {
   public:
-    explicit MultiLightRenderer(const GaussianModel& model);
+    explicit MultiLightRenderer(const SurfelModel& model, RasterBackend backend = RasterBackend::Cpu);
     // The shadowed colour (3 channels, unclamped, black background) of `camera` under each environment, in
     // order: the same as render_with_environment(model, camera, env, ShadingMode::Shadowed).color.
     std::vector<Image> render_shadowed(const Camera& camera, std::span<const ShCoeffs<float>> envs);
 
   private:
-    void shade_pass(std::span<const ShCoeffs<float>> envs);
+    void shade_pass(std::span<const ShCoeffs<float>> envs, const ViewNormals& normals,
+                    SurfelBatch<float>& batch) const;
 
-    const GaussianModel& model_;
-    ViewNormals normals_;
-    SurfelBatch<float> batch_;
-    RasterState<float> state_;
-    RasterImages<float> images_;
+    const SurfelModel& model_;
+    ModelRenderer renderer_;
 };
 
 }  // namespace lumigauss

@@ -172,14 +172,14 @@ const View* find_sol_nerf_view(const Dataset& scene, const std::string& name) {
     return found;
 }
 
-SolNerfResult evaluate_sol_nerf(const GaussianModel& model, const Dataset& scene, const SolNerfConfig& config,
+SolNerfResult evaluate_sol_nerf(const SurfelModel& model, const Dataset& scene, const SolNerfConfig& config,
                                 const SolNerfOptions& options) {
     SolNerfResult result;
     result.config_path = config.path;
     result.downscale = scene.downscale;
     result.angles = options.angles > 0 ? options.angles : config.angles;
-    MultiLightRenderer search(model);
-    RelitRenderer final_render(model);
+    MultiLightRenderer search(model, options.backend);
+    RelitRenderer final_render(model, options.backend);
     for (const SolNerfImageConfig& image : config.images) {
         result.images.push_back(evaluate_image(image, scene, config, options, search, final_render));
         result.search_seconds += result.images.back().search_ms / 1e3;

@@ -10,11 +10,11 @@
 //      photo; the first b with the highest PSNR is kept (an oracle search on the test photo itself, as in
 //      SOL-NeRF; no per-image colour or exposure fit, and the run's learned lighting is not used at all);
 //   4. at that b, the shadowed and the unshadowed render (the unshadowed one takes the angle chosen by the
-//      shadowed PSNR) scored with the official metrics (eval/metrics.h) under the evaluation mask: the mask
-//      file read as gray (an RGB file: its first channel; cv2 would take the luma, the same for gray masks),
-//      resized bilinearly (OpenCV) to the photo's size, eroded once with 5 x 5, and only fully covered pixels
-//      kept (the official mask // 255). Without a configured mask, the scene's own mask of the photo is used
-//      the same way (not the official protocol; the report says which).
+//      shadowed PSNR) scored with the official metrics (io/image_metrics.h) under the evaluation mask: the
+//      mask file read as gray (an RGB file: its first channel; cv2 would take the luma, the same for gray
+//      masks), resized bilinearly (OpenCV) to the photo's size, eroded once with 5 x 5, and only fully
+//      covered pixels kept (the official mask // 255). Without a configured mask, the scene's own mask of the
+//      photo is used the same way (not the official protocol; the report says which).
 // Means are over images (PSNR averaged as PSNR). Renders are at the resolution the scene was loaded at
 // (the official evaluates at the training resolution, -r 1 for NeRF-OSR). A configured photo is evaluated
 // whatever its split (the report records it), where the official script silently skips config entries
@@ -26,10 +26,11 @@
 #include <vector>
 
 #include "lumigauss/eval/gt_env.h"
-#include "lumigauss/eval/metrics.h"
 #include "lumigauss/eval/sol_nerf_config.h"
 #include "lumigauss/io/dataset.h"
-#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/io/image_metrics.h"
+#include "lumigauss/model/surfel_model.h"
+#include "lumigauss/render/rasterizer.h"
 #include "lumigauss/shading/sh.h"
 
 namespace lumigauss {
@@ -91,13 +92,14 @@ struct SolNerfOptions {
     bool keep_panels = true;
     int angles = 0;  // > 0: overrides the config's count
     SolNerfRoots roots;
+    RasterBackend backend = RasterBackend::Cpu;
 };
 
 // Runs the protocol for every image of `config` on `scene` (loaded at the resolution to evaluate) with the
 // relightable `model`. Throws Error naming the config file for an image the scene does not have, naming
 // the environment or mask file when it is missing or unreadable, and naming the mask when it is empty after
 // the erosion.
-SolNerfResult evaluate_sol_nerf(const GaussianModel& model, const Dataset& scene, const SolNerfConfig& config,
+SolNerfResult evaluate_sol_nerf(const SurfelModel& model, const Dataset& scene, const SolNerfConfig& config,
                                 const SolNerfOptions& options = {});
 
 }  // namespace lumigauss

@@ -17,17 +17,7 @@ BakeShading parse_bake_shading(const std::string& text) {
     throw Error("--shading '" + text + "': use shadowed or unshadowed");
 }
 
-Vec4f surfel_unit_quaternion(const GaussianModel& model, std::size_t i) {
-    const auto& q = model.param(ModelParam::Rotation);
-    return normalize_quaternion(Vec4f{q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]});
-}
-
-Vec3f surfel_positive_normal(const GaussianModel& model, std::size_t i) {
-    const Mat3f rot = rotation_from_unit_quaternion(surfel_unit_quaternion(model, i));
-    return {rot.m[0][2], rot.m[1][2], rot.m[2][2]};
-}
-
-std::vector<float> bake_surfel_colours(const GaussianModel& model, const ShCoeffs<float>& env,
+std::vector<float> bake_surfel_colours(const SurfelModel& model, const ShCoeffs<float>& env,
                                        BakeShading shading) {
     const std::size_t n = model.size();
     std::vector<float> out(3 * n);
@@ -42,7 +32,7 @@ std::vector<float> bake_surfel_colours(const GaussianModel& model, const ShCoeff
                 model.transfer_channel0(false, i, neg);
                 rgb = surfel_colour_shadowed(env, albedo, pos, neg, true);
             } else {
-                rgb = surfel_colour_unshadowed(env, albedo, surfel_positive_normal(model, i));
+                rgb = surfel_colour_unshadowed(env, albedo, model.normal(i));
             }
             for (int c = 0; c < 3; ++c) out[3 * i + std::size_t(c)] = std::clamp(rgb[c], 0.0f, 1.0f);
         }

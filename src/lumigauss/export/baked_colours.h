@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/model/surfel_model.h"
 #include "lumigauss/shading/sh.h"
 
 namespace lumigauss {
@@ -22,11 +22,7 @@ enum class BakeShading { Shadowed, Unshadowed };
 BakeShading parse_bake_shading(const std::string& text);
 
 // 3 floats per surfel in [0, 1], computed in float exactly as shade_surfels does for the positive side.
-std::vector<float> bake_surfel_colours(const GaussianModel& model, const ShCoeffs<float>& env,
+std::vector<float> bake_surfel_colours(const SurfelModel& model, const ShCoeffs<float>& env,
                                        BakeShading shading);
-
-// The unit +normal R(q / |q|)[:,2] of surfel i, and its normalised quaternion (w first).
-Vec3f surfel_positive_normal(const GaussianModel& model, std::size_t i);
-Vec4f surfel_unit_quaternion(const GaussianModel& model, std::size_t i);
 
 }  // namespace lumigauss

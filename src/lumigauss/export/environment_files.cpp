@@ -3,8 +3,8 @@
 #include <filesystem>
 #include <map>
 
+#include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/io/image.h"
-#include "lumigauss/relight/up_axis.h"
 #include "lumigauss/shading/envmap.h"
 #include "lumigauss/shading/sh_text.h"
 #include "lumigauss/util/error.h"

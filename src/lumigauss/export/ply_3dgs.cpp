@@ -15,7 +15,7 @@ std::vector<std::string> ply_3dgs_property_names() {
     return names;
 }
 
-void write_3dgs_ply(const std::string& path, const GaussianModel& model, const std::vector<float>& colours) {
+void write_3dgs_ply(const std::string& path, const SurfelModel& model, const std::vector<float>& colours) {
     const std::size_t n = model.size();
     if (colours.size() != 3 * n)
         fail_in_file(path, "internal: " + std::to_string(colours.size()) + " colour values for " +
@@ -26,8 +26,8 @@ void write_3dgs_ply(const std::string& path, const GaussianModel& model, const s
     std::vector<Vec3f> normal(n);
     std::vector<Vec4f> quat(n);
     for (std::size_t i = 0; i < n; ++i) {
-        normal[i] = surfel_positive_normal(model, i);
-        quat[i] = surfel_unit_quaternion(model, i);
+        normal[i] = model.normal(i);
+        quat[i] = model.unit_quaternion(i);
     }
     PlyVertexTable t;
     const auto column = [&](auto&& f) {

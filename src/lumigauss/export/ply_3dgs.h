@@ -10,12 +10,12 @@
 //   scale_0 scale_1   the surfel's two log scales, copied
 //   scale_2           kThinLogScale = log(1e-6): a flat Gaussian standing for the 2D surfel
 //   rot_0..3          the normalised quaternion, w first
-// The project's own 2DGS reader (scene/splat_ply.h: load_2dgs_ply) reads this file too (it ignores scale_2
+// The project's own 2DGS reader (model/splat_ply.h: load_2dgs_ply) reads this file too (it ignores scale_2
 // and the normals), which is how the tests render it back.
 #include <string>
 #include <vector>
 
-#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/model/surfel_model.h"
 
 namespace lumigauss {
 
@@ -28,6 +28,6 @@ std::vector<std::string> ply_3dgs_property_names();
 
 // Writes the file atomically. `colours`: 3 per surfel in [0, 1] (bake_surfel_colours). Throws Error naming
 // the file on a size mismatch or I/O failure.
-void write_3dgs_ply(const std::string& path, const GaussianModel& model, const std::vector<float>& colours);
+void write_3dgs_ply(const std::string& path, const SurfelModel& model, const std::vector<float>& colours);
 
 }  // namespace lumigauss

@@ -5,10 +5,10 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/io/text_file.h"
-#include "lumigauss/relight/up_axis.h"
-#include "lumigauss/scene/relightable_ply.h"
+#include "lumigauss/model/relightable_ply.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {

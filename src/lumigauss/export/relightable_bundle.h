@@ -1,7 +1,7 @@
 #pragma once
 // `--format ply-relightable`: the full relightable model plus the lighting of every training photo, so that
 // other tools can relight it without our MLP. Two files (docs/formats.md describes every field):
-//   FILE.ply                  the official LumiGauss relightable PLY (scene/relightable_ply.h), raw values
+//   FILE.ply                  the official LumiGauss relightable PLY (model/relightable_ply.h), raw values
 //   FILE.environments.json    sidecar (relightable_sidecar_path): the environment radiance SH of every
 //                             training photo, as the lighting MLP gives it (lighting.env_sh(i)), world frame
 // Sidecar layout:
@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "lumigauss/math/vec.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/shading/sh.h"
-#include "lumigauss/train/trained_run.h"
 
 namespace lumigauss {
 

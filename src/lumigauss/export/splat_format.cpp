@@ -40,7 +40,7 @@ std::array<std::uint8_t, kSplatBytes> encode_splat(const SplatRecord& s) {
     return out;
 }
 
-std::vector<SplatRecord> splat_records(const GaussianModel& model, const std::vector<float>& colours) {
+std::vector<SplatRecord> splat_records(const SurfelModel& model, const std::vector<float>& colours) {
     const std::size_t n = model.size();
     if (colours.size() != 3 * n) throw Error("splat_records: colour count does not match the model");
     const auto& xyz = model.param(ModelParam::Xyz);
@@ -53,7 +53,7 @@ std::vector<SplatRecord> splat_records(const GaussianModel& model, const std::ve
         s.scale = {std::exp(sc[2 * i]), std::exp(sc[2 * i + 1]), kThinScale};
         s.colour = {colours[3 * i], colours[3 * i + 1], colours[3 * i + 2]};
         s.alpha = 1.0f / (1.0f + std::exp(-op[i]));
-        s.rotation = surfel_unit_quaternion(model, i);
+        s.rotation = model.unit_quaternion(i);
     }
     return out;
 }

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "lumigauss/math/vec.h"
-#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/model/surfel_model.h"
 
 namespace lumigauss {
 
@@ -33,7 +33,7 @@ struct SplatRecord {
 std::array<std::uint8_t, kSplatBytes> encode_splat(const SplatRecord& s);
 
 // The records of a model with baked colours (3 per surfel), in the model's order.
-std::vector<SplatRecord> splat_records(const GaussianModel& model, const std::vector<float>& colours);
+std::vector<SplatRecord> splat_records(const SurfelModel& model, const std::vector<float>& colours);
 
 // Sorts (see above) and writes the records atomically. Throws Error naming the file on I/O failure.
 void write_splat_file(const std::string& path, std::vector<SplatRecord> records);

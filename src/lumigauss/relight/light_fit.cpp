@@ -4,15 +4,14 @@
 #include <cmath>
 #include <span>
 
-#include "lumigauss/eval/metrics.h"
-#include "lumigauss/render/cpu/blend_weights.h"
-#include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/io/image_metrics.h"
+#include "lumigauss/render/blend_weights.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/train/adam.h"
 #include "lumigauss/train/image_losses.h"
 #include "lumigauss/train/physical_losses.h"
-#include "lumigauss/train/view_shading.h"
+#include "lumigauss/train/view_shading_backward.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {
@@ -128,7 +127,7 @@ class FrozenViewObjective {
                         const LightFitOptions& o)
         : o_(o),
           camera_(camera),
-          model_(run.model),
+          model_(GaussianModel::from_model(run.model, 1.0)),
           photo_(photo),
           mask_(mask.pixels.empty() ? Image(photo.width, photo.height, 1, 1.0f) : mask) {
         mode_ = o.shadowed ? ShadingMode::Shadowed : ShadingMode::Unshadowed;
@@ -138,9 +137,7 @@ class FrozenViewObjective {
         // The geometry is frozen, so the blending weights of one rasterisation serve every step: each
         // evaluation only re-shades the surfels and composites with them (and back), which is exact.
         shade_surfels(model_, uniform_irradiance_environment<float>(), mode_, normals_, batch_);
-        rasterize_forward_cpu(camera_, batch_, settings_, state_, images_);
-        weights_ = blend_weights(state_);
-        state_ = {};  // only the weights and the alpha map are used from here on
+        weights_ = render_blend_weights(camera_, batch_, settings_, images_);
     }
 
     struct Value {
@@ -195,7 +192,7 @@ class FrozenViewObjective {
 
     const LightFitOptions& o_;
     const Camera& camera_;
-    GaussianModel model_;  // a copy: shading's backward writes (unused) gradients into it
+    GaussianModel model_;  // shading's backward writes (unused) gradients into it
     const Image& photo_;
     Image mask_;  // all ones without a mask
     ShadingMode mode_;
@@ -203,7 +200,6 @@ class FrozenViewObjective {
     ViewNormals normals_;
     SurfelBatch<float> batch_;
     RasterSettings<float> settings_;
-    RasterState<float> state_;
     RasterImages<float> images_;
     BlendWeights weights_;
     RasterImageGrads<float> grad_;

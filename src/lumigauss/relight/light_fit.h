@@ -24,8 +24,8 @@
 
 #include "lumigauss/io/camera.h"
 #include "lumigauss/io/image.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/shading/sh.h"
-#include "lumigauss/train/trained_run.h"
 
 namespace lumigauss {
 

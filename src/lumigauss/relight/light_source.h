@@ -15,8 +15,8 @@
 
 #include "lumigauss/io/image.h"
 #include "lumigauss/math/vec.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/shading/sh.h"
-#include "lumigauss/train/trained_run.h"
 
 namespace lumigauss {
 

@@ -5,11 +5,11 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "lumigauss/cameras/orbit.h"
+#include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/io/dataset.h"
-#include "lumigauss/relight/orbit.h"
 #include "lumigauss/relight/relit_render.h"
 #include "lumigauss/relight/relit_sky.h"
-#include "lumigauss/relight/up_axis.h"
 #include "lumigauss/relight/video.h"
 #include "lumigauss/shading/sky_image.h"
 #include "lumigauss/util/error.h"
@@ -55,7 +55,7 @@ std::vector<NamedCamera> filter_views(std::vector<NamedCamera> cameras,
     return kept;
 }
 
-Vec3d model_centre(const GaussianModel& model) {
+Vec3d model_centre(const SurfelModel& model) {
     const auto& xyz = model.param(ModelParam::Xyz);
     std::vector<Vec3f> points(model.size());
     for (std::size_t i = 0; i < points.size(); ++i) points[i] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
@@ -186,7 +186,7 @@ RelightSummary run_relight_job(const RelightJob& job, const std::function<void(c
 
     const std::vector<double> angles =
         job.spin > 0 ? spin_angles(job.spin, job.rotate_degrees) : std::vector<double>{job.rotate_degrees};
-    RelitRenderer renderer(run.model);
+    RelitRenderer renderer(run.model, job.backend);
     for (const NamedCamera& nc : cams.cameras) {
         for (std::size_t k = 0; k < angles.size(); ++k) {
             const auto t0 = std::chrono::steady_clock::now();

@@ -13,9 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "lumigauss/relight/camera_json.h"
+#include "lumigauss/cameras/camera_json.h"
 #include "lumigauss/relight/light_source.h"
 #include "lumigauss/relight/relit_outputs.h"
+#include "lumigauss/render/rasterizer.h"
 
 namespace lumigauss {
 
@@ -37,6 +38,7 @@ struct RelightJob {
     RelitOutputs outputs;
     bool video = true;
     int fps = 15;
+    RasterBackend backend = RasterBackend::Cpu;
 };
 
 struct RelightSummary {

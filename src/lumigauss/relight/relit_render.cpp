@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/surfel_shading.h"
 
@@ -14,27 +13,26 @@ namespace lumigauss {
 
 static_assert(kRelitChannels <= kMaxChannels, "the CPU rasterizer blends at most kMaxChannels channels");
 
-RelitRenderer::RelitRenderer(const GaussianModel& model) : model_(model) {
+RelitRenderer::RelitRenderer(const SurfelModel& model, RasterBackend backend)
+    : model_(model), renderer_(backend) {
     const std::size_t n = model.size();
-    const auto& raw = model.param(ModelParam::Albedo);
     albedo_.resize(3 * n);
     for (std::size_t i = 0; i < n; ++i) {
-        const Vec3f a = albedo_activation(Vec3f{raw[3 * i], raw[3 * i + 1], raw[3 * i + 2]});
+        const Vec3f a = albedo_activation(model.raw_albedo(i));
         for (int c = 0; c < 3; ++c) albedo_[3 * i + std::size_t(c)] = a[c];
     }
-    batch_.channels = kRelitChannels;
-    model.activated(batch_);
 }
 
-const RasterImages<float>& RelitRenderer::render(const Camera& camera, const ShCoeffs<float>& env) {
+void RelitRenderer::shade(const ShCoeffs<float>& env, const ViewNormals& normals, SurfelBatch<float>& batch) {
     const std::size_t n = model_.size();
-    compute_view_normals(model_, camera, normals_);
-    shade_surfels(model_, env, ShadingMode::Both, normals_, shaded_);
+    shade_surfels(model_, env, ShadingMode::Both, normals, shaded_);
     const std::size_t ch = std::size_t(kRelitChannels);
+    batch.channels = kRelitChannels;
+    batch.colors.resize(n * ch);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
         float pos[kTransferCoeffs], neg[kTransferCoeffs];
         for (std::size_t i = r.begin(); i < r.end(); ++i) {
-            float* out = &batch_.colors[i * ch];
+            float* out = &batch.colors[i * ch];
             const float* both = &shaded_.colors[i * std::size_t(kSurfelColourChannels)];
             for (int c = 0; c < 3; ++c) {
                 out[kRelitShadowed + c] = both[kShadowedOffset + c];
@@ -43,17 +41,21 @@ const RasterImages<float>& RelitRenderer::render(const Camera& camera, const ShC
             }
             model_.transfer_channel0(true, i, pos);
             model_.transfer_channel0(false, i, neg);
-            const float* transfer = select_transfer(normals_.positive_side[i] != 0, pos, neg);
+            const float* transfer = select_transfer(normals.positive_side[i] != 0, pos, neg);
             const Vec3f s = shadowed_radiance(transfer, env);
-            const Vec3f u = irradiance(env, normals_.normal[i]);
+            const Vec3f u = irradiance(env, normals.normal[i]);
             for (int c = 0; c < 3; ++c) {
                 out[kRelitIntensityShadowed + c] = light_intensity(s[c]);
                 out[kRelitIntensityUnshadowed + c] = light_intensity(u[c]);
             }
         }
     });
-    rasterize_forward_cpu(camera, batch_, RasterSettings<float>{}, state_, images_);
-    return images_;
+}
+
+const RasterImages<float>& RelitRenderer::render(const Camera& camera, const ShCoeffs<float>& env) {
+    return renderer_.render(model_, camera, [&](const ViewNormals& normals, SurfelBatch<float>& batch) {
+        shade(env, normals, batch);
+    });
 }
 
 Image shadow_image(const Image& unshadowed, const Image& shadowed) {

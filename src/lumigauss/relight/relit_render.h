@@ -13,11 +13,10 @@
 
 #include "lumigauss/io/camera.h"
 #include "lumigauss/io/image.h"
+#include "lumigauss/model/render_model.h"
 #include "lumigauss/render/raster_maps.h"
 #include "lumigauss/render/raster_types.h"
-#include "lumigauss/scene/gaussian_model.h"
 #include "lumigauss/shading/sh.h"
-#include "lumigauss/train/view_shading.h"
 
 namespace lumigauss {
 
@@ -28,18 +27,17 @@ inline constexpr int kRelitShadowed = 0, kRelitUnshadowed = 3, kRelitIntensitySh
 // Renders one model from many cameras and environments, keeping the per-model albedo and the buffers.
 class RelitRenderer {
   public:
-    explicit RelitRenderer(const GaussianModel& model);
+    explicit RelitRenderer(const SurfelModel& model, RasterBackend backend = RasterBackend::Cpu);
     // The raster output: color has kRelitChannels per pixel (layout above), unclamped.
     const RasterImages<float>& render(const Camera& camera, const ShCoeffs<float>& env);
 
   private:
-    const GaussianModel& model_;
+    void shade(const ShCoeffs<float>& env, const ViewNormals& normals, SurfelBatch<float>& batch);
+
+    const SurfelModel& model_;
+    ModelRenderer renderer_;
     std::vector<float> albedo_;  // 3 per surfel, activated
-    ViewNormals normals_;
     SurfelBatch<float> shaded_;  // 6 channels, from shade_surfels
-    SurfelBatch<float> batch_;   // geometry + kRelitChannels channels
-    RasterState<float> state_;
-    RasterImages<float> images_;
 };
 
 // The official shadow image (render_rotate_envmap.py): 1 - clamp(luma(I_unshadowed - I_shadowed), 0, 1000)

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "lumigauss/io/camera.h"
-#include "lumigauss/scene/splat_ply.h"
+#include "lumigauss/model/splat_ply.h"
 #include "lumigauss/synth/world.h"
 
 namespace lumigauss::synth {

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "lumigauss/util/row_arrays.h"
+
 namespace lumigauss {
 
 class AdamGroup {
@@ -60,11 +62,6 @@ class AdamGroup {
     std::int64_t step_ = 0;
     std::vector<float> m_, v_;  // torch's exp_avg and exp_avg_sq
 };
-
-// Row edits of a flat array with rows of `width` floats, shared by parameters and moments so both stay
-// aligned.
-void keep_rows(std::vector<float>& data, int width, std::span<const std::uint8_t> keep);
-void append_copies_of_rows(std::vector<float>& data, int width, std::span<const std::size_t> rows);
 
 // 3DGS `get_expon_lr_func`: log-linear from lr_init (step 0) to lr_final (step >= max_steps), optionally
 // damped for the first delay_steps by delay_mult + (1 - delay_mult) sin(pi/2 clamp(step / delay_steps, 0,

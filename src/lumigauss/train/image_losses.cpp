@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "lumigauss/render/cpu/multiversion.h"
 #include "lumigauss/train/row_parallel.h"
 #include "lumigauss/util/error.h"
+#include "lumigauss/util/multiversion.h"
 
 namespace lumigauss {
 namespace {

@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "lumigauss/math/hd.h"
-#include "lumigauss/render/cpu/multiversion.h"
-#include "lumigauss/synth/rng.h"
 #include "lumigauss/util/error.h"
+#include "lumigauss/util/multiversion.h"
+#include "lumigauss/util/rng.h"
 
 namespace lumigauss {
 namespace {
@@ -20,7 +20,7 @@ constexpr std::uint64_t kTransferDirections = 0x7472616e73ULL;  // "trans"
 constexpr std::uint64_t kEnvDirections = 0x656e76ULL;           // "env"
 
 template <typename T>
-void sample_directions(synth::Rng& rng, int count, Vec3<T>* out) {
+void sample_directions(Rng& rng, int count, Vec3<T>* out) {
     for (int s = 0; s < count; ++s) {
         const Vec3<T> u{T(rng.uniform(-1, 1)), T(rng.uniform(-1, 1)), T(rng.uniform(-1, 1))};
         out[s] = cube_normalized_direction(u);
@@ -118,7 +118,7 @@ LG_HD_INLINE void run_samples_impl(LaneBatch& b, int samples) {
     }
 }
 
-// The sampling loop compiled for baseline x86-64, AVX2 and AVX-512 (render/cpu/multiversion.h).
+// The sampling loop compiled for baseline x86-64, AVX2 and AVX-512 (util/multiversion.h).
 LG_MULTIVERSION void run_samples_with_moments(LaneBatch& b, int samples) {
     run_samples_impl<true>(b, samples);
 }
@@ -156,7 +156,7 @@ TransferLossResult model_transfer_losses(GaussianModel& model, const ViewNormals
                         b.nx[l] = normals.normal[i].x, b.ny[l] = normals.normal[i].y,
                         b.nz[l] = normals.normal[i].z;
                         const std::uint64_t key =
-                            synth::hash_keys(seed, kTransferDirections, std::uint64_t(iteration), i);
+                            hash_keys(seed, kTransferDirections, std::uint64_t(iteration), i);
                         b.key_lo[l] = std::uint32_t(key), b.key_hi[l] = std::uint32_t(key >> 32);
                     }
                     if (moments)
@@ -206,7 +206,7 @@ TransferLossResult model_transfer_losses(GaussianModel& model, const ViewNormals
 
 double env_nonnegativity_loss(const ShCoeffs<float>& env, int samples, std::uint64_t seed,
                               std::int64_t iteration, double weight, ShCoeffs<float>& g_env) {
-    synth::Rng rng(synth::hash_keys(seed, kEnvDirections, std::uint64_t(iteration)));
+    Rng rng(hash_keys(seed, kEnvDirections, std::uint64_t(iteration)));
     std::vector<Vec3<double>> dirs(std::size_t(std::max(samples, 0)));
     sample_directions(rng, samples, dirs.data());
     const ShCoeffs<double> sh = env.cast<double>();

@@ -9,10 +9,10 @@
 // reproducible, independent of the number of threads, and resumable from the iteration number alone.
 #include <cstdint>
 
-#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/model/view_shading.h"
 #include "lumigauss/shading/sh.h"
 #include "lumigauss/shading/surfel_shading.h"
-#include "lumigauss/train/view_shading.h"
+#include "lumigauss/train/gaussian_model.h"
 
 namespace lumigauss {
 

@@ -1,30 +1,15 @@
 #pragma once
-// The files of a training run folder:
-//   config.json       the full TrainConfig (train_config.h), written when the run starts
-//   log.jsonl         one JSON object per logged iteration with every loss term (append-only)
-//   checkpoint.lgck   the latest checkpoint (checkpoint.h), replaced atomically
-//   model.ply         the surfels, official LumiGauss relightable PLY layout (relightable_ply.h)
-//   lighting.lgmlp    the lighting MLP and embedding table (lighting_mlp.h)
-//   appearance.json   the photo names in embedding-table order: {"images": [{"name": ..., "index": i}]}
-//   sky.lgsky         the per-photo sky residuals (sky_residual.h), when the run trained them
-// Every file is written atomically (temp + rename).
+// Writing a training run folder (its layout: model/run_files.h): the finished model of a training state and
+// the log lines.
 #include <string>
-#include <vector>
 
+#include "lumigauss/model/run_files.h"
 #include "lumigauss/train/trainer.h"
 
 namespace lumigauss {
 
-struct RunPaths {
-    std::string dir, config, log, checkpoint, model, lighting, appearance, sky;
-};
-RunPaths run_paths(const std::string& dir);
-
 // model.ply, lighting.lgmlp, appearance.json and (when trained) sky.lgsky of the state.
 void save_run_model(const RunPaths& paths, const TrainState& state);
-
-// The photo names of appearance.json, in embedding order. Throws Error naming the file if malformed.
-std::vector<std::string> load_appearance(const std::string& path);
 
 // One log line (JSON object, no newline) for a step.
 std::string step_log_line(const StepReport& report, double elapsed_seconds);

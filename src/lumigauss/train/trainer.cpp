@@ -7,14 +7,15 @@
 
 #include "lumigauss/io/scene_extent.h"
 #include "lumigauss/render/background.h"
-#include "lumigauss/render/cpu/rasterizer_cpu.h"
+#include "lumigauss/render/rasterizer.h"
 #include "lumigauss/shading/sky_image.h"
-#include "lumigauss/synth/rng.h"
 #include "lumigauss/train/depth_normal.h"
 #include "lumigauss/train/image_losses.h"
 #include "lumigauss/train/physical_losses.h"
 #include "lumigauss/train/sky_losses.h"
+#include "lumigauss/train/view_shading_backward.h"
 #include "lumigauss/util/error.h"
+#include "lumigauss/util/rng.h"
 
 namespace lumigauss {
 namespace {
@@ -161,11 +162,12 @@ struct Trainer::Scratch {
     SkyPixels sky;            // the sky along every ray: radiance and colour
     std::vector<float> g_sky, g_sky_radiance, matched;  // their gradients; background-explained pixels
     SurfelBatch<float> batch;
-    RasterState<float> raster;
+    std::unique_ptr<Rasterizer> rasterizer = make_rasterizer(RasterBackend::Cpu);
+    SurfelFootprints footprints;  // of the last render, for densification
     RasterImages<float> images;
     RasterImageGrads<float> image_grads;
     SurfelGrads<float> surfel_grads;
-    std::vector<float> rendered, grad_rendered, radii, mean2d, damping;
+    std::vector<float> rendered, grad_rendered, mean2d, damping;
     RasterSettings<float> settings;
 };
 
@@ -254,6 +256,10 @@ void Trainer::prepare_view_masks() {
     if (length(up) > 0) up_ = ((1.0 / length(up)) * up).cast<float>();
 }
 
+void Trainer::set_backend(RasterBackend backend) {
+    scratch_->rasterizer = make_rasterizer(backend);
+}
+
 Trainer::~Trainer() = default;
 
 int Trainer::view_for_iteration(std::int64_t iteration) const {
@@ -262,7 +268,7 @@ int Trainer::view_for_iteration(std::int64_t iteration) const {
     const std::int64_t k = iteration - 1, epoch = k / n, pos = k % n;
     std::vector<int> order(static_cast<std::size_t>(n));
     std::iota(order.begin(), order.end(), 0);
-    synth::Rng rng(synth::hash_keys(state_.config.seed, kCameraOrder, std::uint64_t(epoch)));
+    Rng rng(hash_keys(state_.config.seed, kCameraOrder, std::uint64_t(epoch)));
     for (std::int64_t i = n - 1; i > 0; --i)
         std::swap(order[std::size_t(i)], order[std::size_t(rng.uniform_int(0, int(i)))]);
     return order[std::size_t(pos)];
@@ -316,7 +322,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     const LightingForward<float> env_pass = state_.lighting.forward(report.view);
     // 3.5: one noise draw per iteration, shared by both renders; l_+ sees the clean SH.
     ShCoeffs<float> env = env_pass.sh;
-    synth::Rng noise(synth::hash_keys(c.seed, kEnvNoise, std::uint64_t(it)));
+    Rng noise(hash_keys(c.seed, kEnvNoise, std::uint64_t(it)));
     for (int k = 0; k < kShCount; ++k)
         for (int ch = 0; ch < 3; ++ch) env.c[k][ch] += float(noise.normal() * c.env_noise_sigma);
     const ShadingMode mode = stage == Stage::Shadowed ? ShadingMode::Both : ShadingMode::Unshadowed;
@@ -325,7 +331,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     times_.shading += seconds_since(t0);
 
     t0 = Clock::now();
-    rasterize_forward_cpu(view.camera, s.batch, s.settings, s.raster, s.images);
+    s.rasterizer->forward(view.camera, s.batch, s.settings, s.images);
     // The colour sets the losses read: unshadowed RGB alone in stage 1, shadowed and unshadowed in stage 3.
     std::vector<int> colour_sets = {0};
     if (stage != Stage::Unshadowed) colour_sets = {kShadowedOffset, kUnshadowedOffset};
@@ -439,7 +445,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     times_.losses += seconds_since(t0);
 
     t0 = Clock::now();
-    rasterize_backward_cpu(s.batch, s.raster, g, s.surfel_grads);
+    s.rasterizer->backward(s.batch, g, s.surfel_grads);
     const SurfelGrads<float>& sg = s.surfel_grads;
     times_.raster_backward += seconds_since(t0);
 
@@ -461,13 +467,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     lighting_has_grad_ = true;
     // Densification statistics come from this render's screen-space gradient (2DGS: radii > 0 visible).
     if (it < c.densify_until) {
-        const std::size_t n = model.size();
-        s.radii.assign(n, 0.0f);
-        for (std::size_t i = 0; i < n; ++i) {
-            const auto& r = s.raster.footprints[i].rect;
-            if (s.raster.visible[i] && !r.empty())
-                s.radii[i] = 0.5f * float(std::max(r.x1 - r.x0 + 1, r.y1 - r.y0 + 1));
-        }
+        s.rasterizer->footprints(s.footprints);
         s.mean2d = sg.mean2d;
     }
     times_.shading_backward += seconds_since(t0);
@@ -550,13 +550,13 @@ void Trainer::densify_step(std::int64_t it, Stage stage, StepReport& report) {
         const double near = c.densify_near_fraction * state_.scene_extent;
         s.damping.assign(model.size(), 1.0f);
         for (std::size_t i = 0; i < model.size(); ++i)
-            if (s.raster.visible[i]) {
-                const double r = double(s.raster.footprints[i].depth) / near;
+            if (s.footprints.visible[i]) {
+                const double r = double(s.footprints.depth[i]) / near;
                 s.damping[i] = float(std::min(1.0, r * r));
             }
     }
-    model.add_densification_stats(s.mean2d, s.raster.visible, s.radii, view.camera.width, view.camera.height,
-                                  s.damping);
+    model.add_densification_stats(s.mean2d, s.footprints.visible, s.footprints.radius, view.camera.width,
+                                  view.camera.height, s.damping);
     if (it > c.densify_from && it % c.densify_interval == 0) {
         const double max_screen = it > c.opacity_reset_interval ? c.max_screen_size : 0.0;
         DensifyOptions opt;
@@ -564,7 +564,7 @@ void Trainer::densify_step(std::int64_t it, Stage stage, StepReport& report) {
         opt.faithful_radii_reset = c.faithful_radii_reset;
         report.densified =
             model.densify_and_prune(c.densify_grad_threshold, c.min_opacity, state_.scene_extent, max_screen,
-                                    synth::hash_keys(c.seed, kDensify, std::uint64_t(it)), opt);
+                                    hash_keys(c.seed, kDensify, std::uint64_t(it)), opt);
         report.densify_ran = true;
         // torch: the replaced parameter tensors have no gradient, so Adam skips them this iteration.
         model.zero_grad();

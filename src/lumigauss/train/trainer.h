@@ -14,13 +14,14 @@
 
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
+#include "lumigauss/model/lighting_mlp.h"
+#include "lumigauss/model/sky_residual.h"
+#include "lumigauss/model/view_shading.h"
 #include "lumigauss/render/raster_types.h"
-#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/render/rasterizer.h"
 #include "lumigauss/train/adam.h"
-#include "lumigauss/train/lighting_mlp.h"
-#include "lumigauss/train/sky_residual.h"
+#include "lumigauss/train/gaussian_model.h"
 #include "lumigauss/train/train_config.h"
-#include "lumigauss/train/view_shading.h"
 
 namespace lumigauss {
 
@@ -90,6 +91,10 @@ class Trainer {
     // Continues a saved state. Throws Error if the photos differ from the ones the state was trained on.
     Trainer(std::vector<TrainView> views, TrainState state);
     ~Trainer();
+
+    // Which backend rasterizes (forward and backward); the rest of the iteration runs on the CPU. The CPU
+    // backend unless told otherwise. Throws Error when the backend cannot run here.
+    void set_backend(RasterBackend backend);
 
     // Runs iteration() + 1. Throws NonFiniteError (state untouched by that iteration's update) if a loss
     // term or a gradient is not finite.

@@ -32,7 +32,7 @@ std::size_t put_block(std::string& out, std::size_t at, std::size_t n, int width
 
 }  // namespace
 
-std::string encode_model_payload(const GaussianModel& model) {
+std::string encode_model_payload(const SurfelModel& model) {
     const std::size_t n = model.size();
     if (n > std::numeric_limits<std::uint32_t>::max())
         throw Error("view: the model has too many surfels for the viewer payload (" + std::to_string(n) +
@@ -46,7 +46,7 @@ std::string encode_model_payload(const GaussianModel& model) {
     for (ModelParam p : {ModelParam::Xyz, ModelParam::Rotation, ModelParam::Scaling, ModelParam::Opacity,
                          ModelParam::Albedo}) {
         const std::vector<float>& v = model.param(p);
-        const int w = GaussianModel::width(p);
+        const int w = SurfelModel::width(p);
         at = put_block(out, at, n, w,
                        [&](std::size_t i, int k) { return v[i * std::size_t(w) + std::size_t(k)]; });
     }

@@ -16,13 +16,13 @@
 //                       opacity      N x 1  logit                       (activation sigmoid)
 //                       albedo       N x 3  raw a; albedo = max(0, Y00 a + 0.5)
 //                       transfer_pos N x 9  channel 0 of the positive transfer set (the only channel the
-//                       transfer_neg N x 9  shading reads, scene/gaussian_model.h), SH order of shading/sh.h
+//                       transfer_neg N x 9  shading reads, model/surfel_model.h), SH order of shading/sh.h
 // Every block starts at a multiple of 4 bytes, so the page views each one as a Float32Array without copying.
 // Total size: 32 + 124 N bytes.
 #include <cstdint>
 #include <string>
 
-#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/model/surfel_model.h"
 
 namespace lumigauss::view {
 
@@ -32,6 +32,6 @@ inline constexpr std::size_t kPayloadHeaderBytes = 32;
 inline constexpr int kPayloadFloatsPerSurfel = 3 + 4 + 2 + 1 + 3 + 2 * kTransferCoeffs;
 
 // The payload of `model` (layout above). Throws Error when the model has more than 2^32 - 1 surfels.
-std::string encode_model_payload(const GaussianModel& model);
+std::string encode_model_payload(const SurfelModel& model);
 
 }  // namespace lumigauss::view

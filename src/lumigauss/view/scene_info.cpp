@@ -5,8 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "lumigauss/relight/orbit.h"
-#include "lumigauss/relight/up_axis.h"
+#include "lumigauss/cameras/orbit.h"
+#include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/shading/irradiance.h"
 
 namespace lumigauss::view {
@@ -32,7 +32,7 @@ json camera_json(const Camera& c) {
 }
 
 // Centre and radius of the bulk of the surfels (see the header); a unit sphere at the origin when empty.
-void model_extent(const GaussianModel& model, ViewerScene& scene) {
+void model_extent(const SurfelModel& model, ViewerScene& scene) {
     const std::vector<float>& xyz = model.param(ModelParam::Xyz);
     const std::size_t n = model.size();
     if (n == 0) return;

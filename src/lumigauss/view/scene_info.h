@@ -19,9 +19,9 @@
 
 #include "lumigauss/io/camera.h"
 #include "lumigauss/math/vec.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_source.h"
 #include "lumigauss/shading/sh.h"
-#include "lumigauss/train/trained_run.h"
 
 namespace lumigauss::view {
 

@@ -1,10 +1,11 @@
-#include "lumigauss/render/cpu/blend_weights.h"
+#include "lumigauss/render/cpu/blend_weights_cpu.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 
+#include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/render/raster_constants.h"
 #include "lumigauss/render/surfel_kernel.h"
 
@@ -44,6 +45,13 @@ void row_pairs(const RasterState<float>& st, int y, PixelPairs& out) {
 }
 
 }  // namespace
+
+BlendWeights render_blend_weights(const Camera& camera, const SurfelBatch<float>& surfels,
+                                  const RasterSettings<float>& settings, RasterImages<float>& images) {
+    RasterState<float> state;
+    rasterize_forward_cpu(camera, surfels, settings, state, images);
+    return blend_weights(state);
+}
 
 BlendWeights blend_weights(const RasterState<float>& st) {
     BlendWeights bw;

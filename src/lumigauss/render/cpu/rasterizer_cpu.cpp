@@ -9,12 +9,12 @@
 #include <memory>
 #include <string>
 
-#include "lumigauss/render/cpu/multiversion.h"
 #include "lumigauss/render/cpu/tile_backward.h"
 #include "lumigauss/render/cpu/tile_binning.h"
 #include "lumigauss/render/cpu/tile_kernels.h"
 #include "lumigauss/util/error.h"
 #include "lumigauss/util/huge_pages.h"
+#include "lumigauss/util/multiversion.h"
 
 namespace lumigauss {
 namespace {

@@ -6,6 +6,7 @@
 // backward: per tile, the same walk back to front; each (surfel, tile) pair owns one gradient slot, so
 //           tiles never write to the same memory; a per-surfel pass then sums its slots and runs the
 //           projection backward. Memory is linear in surfels + intersections, independent of threads.
+#include "lumigauss/render/cpu/raster_state.h"
 #include "lumigauss/render/raster_types.h"
 
 namespace lumigauss {

@@ -1,6 +1,6 @@
 #pragma once
 // Binning of surfels into 16x16 tiles: per tile, the list of surfels touching it, front to back.
-#include "lumigauss/render/raster_types.h"
+#include "lumigauss/render/cpu/raster_state.h"
 
 namespace lumigauss {
 

@@ -20,7 +20,7 @@
 #include "lumigauss/math/hd.h"
 #include "lumigauss/render/cpu/bit_transpose.h"
 #include "lumigauss/render/cpu/lane_pack.h"
-#include "lumigauss/render/raster_types.h"
+#include "lumigauss/render/cpu/raster_state.h"
 #include "lumigauss/render/splat_reach.h"
 
 namespace lumigauss::cpu {

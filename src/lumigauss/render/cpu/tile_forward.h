@@ -9,6 +9,7 @@
 #include <cstdint>
 
 #include "lumigauss/render/cpu/lane_pack.h"
+#include "lumigauss/render/cpu/raster_state.h"
 #include "lumigauss/render/cpu/tile_blocks.h"
 #include "lumigauss/render/pixel_blend.h"
 #include "lumigauss/render/surfel_kernel.h"

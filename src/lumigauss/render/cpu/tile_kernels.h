@@ -3,8 +3,8 @@
 // (baseline x86-64, AVX2+FMA, AVX-512) and the best one the processor has is picked at load time, so one
 // binary runs everywhere and uses the widest vectors available for its packs of eight pixels. The double
 // versions (references and tests) are plain.
+#include "lumigauss/render/cpu/raster_state.h"
 #include "lumigauss/render/cpu/tile_blocks.h"
-#include "lumigauss/render/raster_types.h"
 
 namespace lumigauss::cpu {
 

@@ -1,7 +1,7 @@
-#include "lumigauss/render/cpu/multiversion.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/render/cpu/tile_backward.h"
 #include "lumigauss/render/cpu/tile_kernels.h"
+#include "lumigauss/util/multiversion.h"
 
 namespace lumigauss::cpu {
 

@@ -23,6 +23,8 @@ CudaRasterizer::~CudaRasterizer() = default;
 void CudaRasterizer::forward(const Camera&, const SurfelBatch<float>&, const RasterSettings<float>&,
                              RasterImages<float>&) {}
 void CudaRasterizer::backward(const RasterImageGrads<float>&, SurfelGrads<float>&) {}
+void CudaRasterizer::download_footprints(std::vector<SplatFootprint<float>>&,
+                                         std::vector<std::uint8_t>&) const {}
 std::size_t CudaRasterizer::intersections() const {
     return 0;
 }

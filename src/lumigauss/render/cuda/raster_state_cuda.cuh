@@ -8,6 +8,7 @@
 #include "lumigauss/render/cuda/rasterizer_cuda.h"
 #include "lumigauss/render/gradient_slot.h"
 #include "lumigauss/render/raster_types.h"
+#include "lumigauss/render/splat_footprint.h"
 
 namespace lumigauss::cuda {
 

@@ -162,6 +162,18 @@ void CudaRasterizer::backward(const RasterImageGrads<float>& grads, SurfelGrads<
     m.times.grads_download = m.events.ms(3, 4);
 }
 
+void CudaRasterizer::download_footprints(std::vector<SplatFootprint<float>>& footprints,
+                                         std::vector<std::uint8_t>& visible) const {
+    const Impl& m = *impl_;
+    if (!m.has_forward) throw Error("CUDA rasterizer: footprints asked for before any forward");
+    std::vector<std::uint32_t> tiles;
+    m.st.footprints.download(footprints, m.stream);
+    m.st.tiles_touched.download(tiles, m.stream);
+    cuda::check(cudaStreamSynchronize(m.stream), "footprints");
+    visible.resize(tiles.size());
+    for (std::size_t i = 0; i < tiles.size(); ++i) visible[i] = tiles[i] != 0 ? 1 : 0;
+}
+
 std::size_t CudaRasterizer::intersections() const {
     return impl_->st.entries;
 }

@@ -16,8 +16,10 @@
 // exist and say so (cuda_backend_available() is false and a CudaRasterizer cannot be made).
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "lumigauss/render/raster_types.h"
+#include "lumigauss/render/splat_footprint.h"
 
 namespace lumigauss {
 
@@ -50,6 +52,11 @@ class CudaRasterizer {
                  const RasterSettings<float>& settings, RasterImages<float>& images);
     // Gradients of the surfels of the last forward from gradients on its maps (an empty map: zero).
     void backward(const RasterImageGrads<float>& grads, SurfelGrads<float>& out);
+
+    // Per surfel of the last forward: its footprint (pixel box, normal, depth; unspecified where not
+    // visible) and whether it reached a tile.
+    void download_footprints(std::vector<SplatFootprint<float>>& footprints,
+                             std::vector<std::uint8_t>& visible) const;
 
     std::size_t intersections() const;  // (surfel, tile) entries of the last forward
     const CudaPhaseTimes& phase_ms() const;

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "lumigauss/cameras/camera_json.h"
 #include "lumigauss/io/camera.h"
 #include "lumigauss/math/vec.h"
-#include "lumigauss/relight/camera_json.h"
 
 namespace lumigauss {
 

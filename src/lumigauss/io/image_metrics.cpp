@@ -1,4 +1,4 @@
-#include "lumigauss/eval/metrics.h"
+#include "lumigauss/io/image_metrics.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,11 +1,11 @@
-#include "lumigauss/scene/splat_ply.h"
+#include "lumigauss/model/splat_ply.h"
 
 #include <tbb/parallel_for.h>
 
 #include <cmath>
 
 #include "lumigauss/io/ply.h"
-#include "lumigauss/scene/view_sh.h"
+#include "lumigauss/model/view_sh.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {

@@ -1,4 +1,4 @@
-#include "lumigauss/train/sky_residual.h"
+#include "lumigauss/model/sky_residual.h"
 
 #include <algorithm>
 #include <cstdint>

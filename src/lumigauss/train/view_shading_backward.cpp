@@ -1,12 +1,12 @@
-#include "lumigauss/train/view_shading.h"
+#include "lumigauss/train/view_shading_backward.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <vector>
 
 #include "lumigauss/math/quaternion.h"
-#include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/util/error.h"
 
@@ -26,80 +26,10 @@ void for_each_chunk(std::size_t n, F&& f) {
                       });
 }
 
-Vec4f raw_quaternion(const GaussianModel& model, std::size_t i) {
+Vec4f raw_quaternion(const SurfelModel& model, std::size_t i) {
     const auto& q = model.param(ModelParam::Rotation);
     return {q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]};
 }
-
-Vec3f raw_albedo(const GaussianModel& model, std::size_t i) {
-    const auto& a = model.param(ModelParam::Albedo);
-    return {a[3 * i], a[3 * i + 1], a[3 * i + 2]};
-}
-
-bool uses_unshadowed(ShadingMode mode) {
-    return mode != ShadingMode::Shadowed;
-}
-bool uses_shadowed(ShadingMode mode) {
-    return mode != ShadingMode::Unshadowed;
-}
-
-}  // namespace
-
-int shading_channels(ShadingMode mode) {
-    return mode == ShadingMode::Both ? kSurfelColourChannels : 3;
-}
-
-void compute_view_normals(const GaussianModel& model, const Camera& camera, ViewNormals& out) {
-    const std::size_t n = model.size();
-    out.normal.resize(n);
-    out.positive_side.resize(n);
-    const Mat3f w = camera.rotation.cast<float>();
-    const Vec3f t = camera.translation.cast<float>();
-    const auto& xyz = model.param(ModelParam::Xyz);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i < r.end(); ++i) {
-            const Mat3f rot = rotation_from_unit_quaternion(normalize_quaternion(raw_quaternion(model, i)));
-            const Vec3f axis{rot.m[0][2], rot.m[1][2], rot.m[2][2]};
-            const Vec3f p_view = w * Vec3f{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]} + t;
-            // Official: cos = -(W n) . p_view, multiplier +1 when cos >= 0.
-            const bool positive = -dot(w * axis, p_view) >= 0.0f;
-            out.positive_side[i] = positive ? 1 : 0;
-            out.normal[i] = positive ? axis : -axis;
-        }
-    });
-}
-
-void shade_surfels(const GaussianModel& model, const ShCoeffs<float>& env, ShadingMode mode,
-                   const ViewNormals& normals, SurfelBatch<float>& batch) {
-    const std::size_t n = model.size();
-    if (normals.normal.size() != n)
-        throw Error("shade_surfels: normals were computed for another model size");
-    const int channels = shading_channels(mode);
-    batch.channels = channels;
-    batch.colors.resize(n * std::size_t(channels));
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
-        float pos[kTransferCoeffs], neg[kTransferCoeffs];
-        for (std::size_t i = r.begin(); i < r.end(); ++i) {
-            float* out = &batch.colors[i * std::size_t(channels)];
-            const Vec3f albedo = raw_albedo(model, i);
-            const bool positive = normals.positive_side[i] != 0;
-            if (uses_shadowed(mode)) {
-                model.transfer_channel0(true, i, pos);
-                model.transfer_channel0(false, i, neg);
-            }
-            if (mode == ShadingMode::Both) {
-                surfel_colour_both(env, albedo, normals.normal[i], pos, neg, positive, out);
-                continue;
-            }
-            const Vec3f rgb = mode == ShadingMode::Unshadowed
-                                  ? surfel_colour_unshadowed(env, albedo, normals.normal[i])
-                                  : surfel_colour_shadowed(env, albedo, pos, neg, positive);
-            for (int c = 0; c < 3; ++c) out[c] = rgb[c];
-        }
-    });
-}
-
-namespace {
 
 // dL/d(raw quaternion) from dL/d(camera-flipped normal): n = flip * R(q/|q|)[:,2].
 Vec4f normal_to_quaternion_grad(Vec4f raw, bool positive, Vec3f g_normal) {
@@ -134,7 +64,7 @@ ShCoeffs<float> shade_surfels_backward(GaussianModel& model, const ShCoeffs<floa
         float pos[kTransferCoeffs], neg[kTransferCoeffs];
         for (std::size_t i = begin; i < end; ++i) {
             const float* g = &g_colors[i * std::size_t(channels)];
-            const Vec3f albedo = raw_albedo(model, i);
+            const Vec3f albedo = model.raw_albedo(i);
             const bool positive = normals.positive_side[i] != 0;
             const Vec3f normal = normals.normal[i];
             float gp[kTransferCoeffs]{}, gn[kTransferCoeffs]{};
@@ -170,17 +100,6 @@ ShCoeffs<float> shade_surfels_backward(GaussianModel& model, const ShCoeffs<floa
     for (const auto& p : partial)
         for (int k = 0; k < kShCount; ++k) total.c[k] = total.c[k] + p.c[k];
     return total.cast<float>();
-}
-
-RasterImages<float> render_with_environment(const GaussianModel& model, const Camera& camera,
-                                            const ShCoeffs<float>& env, ShadingMode mode) {
-    ViewNormals normals;
-    compute_view_normals(model, camera, normals);
-    SurfelBatch<float> batch;
-    model.activated(batch);
-    shade_surfels(model, env, mode, normals, batch);
-    RasterState<float> state;
-    return rasterize_forward_cpu(camera, batch, RasterSettings<float>{}, state);
 }
 
 }  // namespace lumigauss

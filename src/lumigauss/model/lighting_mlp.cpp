@@ -1,4 +1,4 @@
-#include "lumigauss/train/lighting_mlp.h"
+#include "lumigauss/model/lighting_mlp.h"
 
 #include <algorithm>
 #include <bit>

@@ -1,10 +1,10 @@
-#include "lumigauss/scene/point_normals.h"
+#include "lumigauss/model/point_normals.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 
-#include "lumigauss/scene/knn.h"
+#include "lumigauss/model/knn.h"
 
 namespace lumigauss {
 

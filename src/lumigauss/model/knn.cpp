@@ -1,4 +1,4 @@
-#include "lumigauss/scene/knn.h"
+#include "lumigauss/model/knn.h"
 
 #include <algorithm>
 #include <array>

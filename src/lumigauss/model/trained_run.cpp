@@ -1,4 +1,4 @@
-#include "lumigauss/train/trained_run.h"
+#include "lumigauss/model/trained_run.h"
 
 #include <algorithm>
 #include <cctype>
@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lumigauss/io/text_file.h"
-#include "lumigauss/scene/relightable_ply.h"
+#include "lumigauss/model/relightable_ply.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {

@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include "lumigauss/io/camera.h"
 #include "lumigauss/render/raster_types.h"
 
 namespace lumigauss {
@@ -25,10 +26,11 @@ struct BlendWeights {
     std::size_t pairs() const { return pixel_surfel.size(); }
 };
 
-// The weights of the forward pass that filled `state` (rasterize_forward_cpu on the same surfels), by the
-// forward's own rules: the shared per-pixel kernel, the alpha clamp, the 1/255 skip and the transmittance
-// stop, in the tile's front-to-back order.
-BlendWeights blend_weights(const RasterState<float>& state);
+// Rasterizes `surfels` from `camera` into `images` and returns that forward's weights, by its own rules:
+// the shared per-pixel kernel, the alpha clamp, the 1/255 skip and the transmittance stop, in each tile's
+// front-to-back order. (Runs on the CPU backend, whose tile lists the weights are read from.)
+BlendWeights render_blend_weights(const Camera& camera, const SurfelBatch<float>& surfels,
+                                  const RasterSettings<float>& settings, RasterImages<float>& images);
 
 // colors (channels per surfel) -> channels per pixel: sum_i w_i c_i (no background).
 void composite(const BlendWeights& weights, std::span<const float> colors, int channels,

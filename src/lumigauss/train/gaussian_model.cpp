@@ -1,27 +1,19 @@
-#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/train/gaussian_model.h"
 
 #include <algorithm>
 #include <cmath>
 #include <utility>
 
 #include "lumigauss/math/quaternion.h"
-#include "lumigauss/scene/knn.h"
-#include "lumigauss/scene/point_normals.h"
+#include "lumigauss/model/knn.h"
+#include "lumigauss/model/point_normals.h"
 #include "lumigauss/shading/sh.h"
-#include "lumigauss/synth/rng.h"
 #include "lumigauss/util/error.h"
+#include "lumigauss/util/rng.h"
 
 namespace lumigauss {
 
 namespace {
-
-constexpr ModelParam kAll[kModelParamCount] = {
-    ModelParam::Xyz,    ModelParam::Rotation,         ModelParam::Scaling,         ModelParam::Opacity,
-    ModelParam::Albedo, ModelParam::TransferPositive, ModelParam::TransferNegative};
-
-float sigmoid(float x) {
-    return 1.0f / (1.0f + std::exp(-x));
-}
 
 // Random streams of the model, distinct from the synthetic-scene purposes in synth/rng.h.
 constexpr std::uint64_t kRotationStream = 0x524f54;  // "ROT"
@@ -29,31 +21,16 @@ constexpr std::uint64_t kSplitStream = 0x53504c;     // "SPL"
 
 }  // namespace
 
-float inverse_sigmoid(float p) {
-    return std::log(p / (1.0f - p));
-}
-
-int GaussianModel::width(ModelParam p) {
-    constexpr int widths[kModelParamCount] = {3, 4, 2, 1, 3, kTransferStored, kTransferStored};
-    return widths[int(p)];
-}
-
-const char* GaussianModel::name(ModelParam p) {
-    constexpr const char* names[kModelParamCount] = {"xyz",    "rotation",   "scaling",   "opacity",
-                                                     "albedo", "f_positive", "f_negative"};
-    return names[int(p)];
-}
-
 GaussianModel GaussianModel::from_points(const std::vector<Vec3f>& xyz, const std::vector<Vec3f>& rgb,
                                          double spatial_lr_scale, std::uint64_t seed,
                                          const ModelLearningRates& lr, bool orient_from_points) {
     if (xyz.size() != rgb.size()) throw Error("GaussianModel: point and colour counts differ");
     const std::size_t n = xyz.size();
     std::vector<std::vector<float>> raw(kModelParamCount);
-    for (ModelParam p : kAll) raw[int(p)].reserve(n * std::size_t(width(p)));
+    for (ModelParam p : kAllModelParams) raw[int(p)].reserve(n * std::size_t(width(p)));
     // dist2 = clamp_min(distCUDA2(points), 1e-7); scales = log(sqrt(dist2)) on both axes.
     const std::vector<double> dist2 = mean_sq_dist_knn(xyz, 3);
-    synth::Rng rot_rng(synth::hash_keys(seed, kRotationStream));
+    Rng rot_rng(hash_keys(seed, kRotationStream));
     const float opacity = inverse_sigmoid(0.1f);
     const std::vector<Vec3f> normals = orient_from_points ? point_normals(xyz) : std::vector<Vec3f>{};
     for (std::size_t i = 0; i < n; ++i) {
@@ -76,20 +53,19 @@ GaussianModel GaussianModel::from_points(const std::vector<Vec3f>& xyz, const st
     return from_raw(std::move(raw), spatial_lr_scale, lr);
 }
 
-GaussianModel GaussianModel::from_raw(std::vector<std::vector<float>> raw, double spatial_lr_scale,
-                                      const ModelLearningRates& lr) {
-    if (raw.size() != std::size_t(kModelParamCount)) throw Error("GaussianModel: wrong number of arrays");
+GaussianModel GaussianModel::from_model(SurfelModel model, double spatial_lr_scale,
+                                        const ModelLearningRates& lr) {
     GaussianModel m;
-    const std::size_t n = raw[0].size() / 3;
-    for (ModelParam p : kAll) {
-        if (raw[int(p)].size() != n * std::size_t(width(p)))
-            throw Error(std::string("GaussianModel: array '") + name(p) + "' has the wrong size");
-        m.params_[int(p)] = std::move(raw[int(p)]);
-        m.grads_[int(p)].assign(m.params_[int(p)].size(), 0.0f);
-    }
+    static_cast<SurfelModel&>(m) = std::move(model);
+    for (ModelParam p : kAllModelParams) m.grads_[int(p)].assign(m.params_[int(p)].size(), 0.0f);
     m.init_optimizer(lr, spatial_lr_scale);
     m.reset_stats();
     return m;
+}
+
+GaussianModel GaussianModel::from_raw(std::vector<std::vector<float>> raw, double spatial_lr_scale,
+                                      const ModelLearningRates& lr) {
+    return from_model(SurfelModel::from_raw(std::move(raw)), spatial_lr_scale, lr);
 }
 
 void GaussianModel::init_optimizer(const ModelLearningRates& lr, double spatial_lr_scale) {
@@ -104,31 +80,13 @@ void GaussianModel::init_optimizer(const ModelLearningRates& lr, double spatial_
                                             lr.albedo,
                                             lr.transfer,
                                             lr.transfer};
-    for (ModelParam p : kAll)
+    for (ModelParam p : kAllModelParams)
         adam_[int(p)] = AdamGroup(name(p), params_[int(p)].size(), rates[int(p)], width(p));
 }
 
 std::span<float> GaussianModel::grad(ModelParam p) {
     has_grad_[int(p)] = true;
     return grads_[int(p)];
-}
-
-void GaussianModel::transfer_channel0(bool positive, std::size_t i, float out[kTransferCoeffs]) const {
-    const auto& t = param(positive ? ModelParam::TransferPositive : ModelParam::TransferNegative);
-    for (int k = 0; k < kTransferCoeffs; ++k) out[k] = t[i * kTransferStored + std::size_t(3 * k)];
-}
-
-void GaussianModel::activated(SurfelBatch<float>& batch) const {
-    const std::size_t n = size();
-    batch.resize(n);
-    const auto& xyz = param(ModelParam::Xyz);
-    std::copy(xyz.begin(), xyz.end(), batch.means.begin());
-    const auto& rot = param(ModelParam::Rotation);
-    std::copy(rot.begin(), rot.end(), batch.quats.begin());
-    const auto& s = param(ModelParam::Scaling);
-    for (std::size_t i = 0; i < s.size(); ++i) batch.scales[i] = std::exp(s[i]);
-    const auto& o = param(ModelParam::Opacity);
-    for (std::size_t i = 0; i < n; ++i) batch.opacities[i] = sigmoid(o[i]);
 }
 
 void GaussianModel::accumulate_grads_from_activated(const SurfelGrads<float>& g) {
@@ -151,7 +109,7 @@ void GaussianModel::accumulate_grads_from_activated(const SurfelGrads<float>& g)
 }
 
 void GaussianModel::zero_grad() {
-    for (ModelParam p : kAll) {
+    for (ModelParam p : kAllModelParams) {
         std::fill(grads_[int(p)].begin(), grads_[int(p)].end(), 0.0f);
         has_grad_[int(p)] = false;
     }
@@ -163,7 +121,7 @@ double GaussianModel::position_lr(std::int64_t iteration) const {
 
 void GaussianModel::step(std::int64_t iteration) {
     adam(ModelParam::Xyz).set_lr(position_lr(iteration));
-    for (ModelParam p : kAll)
+    for (ModelParam p : kAllModelParams)
         if (has_grad_[int(p)]) adam_[int(p)].step(params_[int(p)], grads_[int(p)]);
 }
 
@@ -207,7 +165,7 @@ void GaussianModel::add_densification_stats(std::span<const float> mean2d_grad,
 }
 
 void GaussianModel::append_rows(const std::vector<std::vector<float>>& rows, bool reset_radii) {
-    for (ModelParam p : kAll) {
+    for (ModelParam p : kAllModelParams) {
         auto& v = params_[int(p)];
         v.insert(v.end(), rows[int(p)].begin(), rows[int(p)].end());
         grads_[int(p)].resize(v.size(), 0.0f);
@@ -222,8 +180,8 @@ void GaussianModel::append_rows(const std::vector<std::vector<float>>& rows, boo
 
 void GaussianModel::keep_rows(std::span<const std::uint8_t> keep) {
     if (keep.size() != size()) throw Error("GaussianModel::keep_rows: mask size differs from the model");
-    for (ModelParam p : kAll) {
-        lumigauss::keep_rows(params_[int(p)], width(p), keep);
+    keep_parameter_rows(keep);
+    for (ModelParam p : kAllModelParams) {
         lumigauss::keep_rows(grads_[int(p)], width(p), keep);
         adam_[int(p)].keep_rows(keep);
     }
@@ -247,7 +205,7 @@ std::size_t GaussianModel::clone(const std::vector<float>& grads, double thresho
     const auto& s = param(ModelParam::Scaling);
     for (std::size_t i = 0; i < grads.size(); ++i) {
         if (!(grads[i] >= threshold) || !(max_scale(s, i) <= percent_dense * extent)) continue;
-        for (ModelParam p : kAll) {
+        for (ModelParam p : kAllModelParams) {
             const auto w = std::size_t(width(p));
             const auto& v = params_[int(p)];
             rows[int(p)].insert(rows[int(p)].end(), v.begin() + std::ptrdiff_t(i * w),
@@ -269,7 +227,7 @@ std::size_t GaussianModel::split(const std::vector<float>& grads, double thresho
     for (std::size_t i = 0; i < std::min(n, grads.size()); ++i)
         if (grads[i] >= threshold && max_scale(s, i) > percent_dense * extent) selected.push_back(i);
     std::vector<std::vector<float>> rows(kModelParamCount);
-    synth::Rng rng(synth::hash_keys(seed, kSplitStream, n));
+    Rng rng(hash_keys(seed, kSplitStream, n));
     const auto& xyz = param(ModelParam::Xyz);
     const auto& rot = param(ModelParam::Rotation);
     // .repeat(N, 1): all selected rows once, then all again (not interleaved).
@@ -283,7 +241,7 @@ std::size_t GaussianModel::split(const std::vector<float>& grads, double thresho
             const Mat3<double> r = rotation_from_unit_quaternion(q);
             for (int a = 0; a < 3; ++a)
                 rows[0].push_back(float(r.m[a][0] * u + r.m[a][1] * v + double(xyz[3 * i + std::size_t(a)])));
-            for (ModelParam p : kAll) {
+            for (ModelParam p : kAllModelParams) {
                 if (p == ModelParam::Xyz) continue;
                 const auto w = std::size_t(width(p));
                 const auto& src = params_[int(p)];

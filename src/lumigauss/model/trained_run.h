@@ -1,22 +1,22 @@
 #pragma once
 // A finished training run, loaded for rendering and evaluation: the surfels (model.ply), the lighting MLP
 // (lighting.lgmlp) and the photo names in embedding order (appearance.json), plus the training resolution
-// from config.json when present. The run folder layout is run_folder.h's.
+// from config.json when present. The run folder layout is run_files.h's.
 #include <string>
 #include <vector>
 
-#include "lumigauss/scene/gaussian_model.h"
+#include "lumigauss/model/lighting_mlp.h"
+#include "lumigauss/model/run_files.h"
+#include "lumigauss/model/sky_residual.h"
+#include "lumigauss/model/surfel_model.h"
 #include "lumigauss/shading/sh.h"
-#include "lumigauss/train/lighting_mlp.h"
-#include "lumigauss/train/run_folder.h"
-#include "lumigauss/train/sky_residual.h"
 
 namespace lumigauss {
 
 struct TrainedRun {
     std::string dir;
     RunPaths paths;
-    GaussianModel model;
+    SurfelModel model;
     LightingMlp lighting;
     std::vector<std::string> image_names;  // appearance.json, in embedding order
     int downscale = 0;                     // config.json "downscale"; 0 if unknown
@@ -38,7 +38,7 @@ TrainedRun load_trained_run(const std::string& dir);
 bool is_bare_ply(const std::string& path);
 
 // A run folder through load_trained_run, or a bare relightable PLY in the official LumiGauss layout
-// (scene/relightable_ply.h: what the Python code's `save_ply` writes, and a run's model.ply) as a run with no
+// (model/relightable_ply.h: what the Python code's `save_ply` writes, and a run's model.ply) as a run with no
 // photos (dir = the PLY's folder, paths.model = the PLY), so that models trained with the official code can
 // be relit and exported with external lights (SH files, panoramas). Throws Error naming the path when it is
 // neither, or what load_trained_run / load_relightable_ply throw.

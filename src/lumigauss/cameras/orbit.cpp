@@ -1,4 +1,4 @@
-#include "lumigauss/relight/orbit.h"
+#include "lumigauss/cameras/orbit.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,18 +1,9 @@
 #pragma once
-// The trainable surfel model of the official LumiGauss (`scene/gaussian_model.py:GaussianModel`), as raw
-// (pre-activation) parameters in structure-of-arrays form, each attribute with its own Adam group, plus the
-// densification bookkeeping (research/lumigauss_official.md 2.1, 5; research/2dgs_rasterizer.md 6).
-//
-// Official tensors and their storage here (row-major float, one row per surfel):
-//   _xyz                      N x 3         xyz        identity
-//   _rotation                 N x 4         rotation   raw quaternion w x y z (normalised where used)
-//   _scaling                  N x 2         scaling    log s_u, log s_v (activation exp)
-//   _opacity                  N x 1         opacity    logit (activation sigmoid)
-//   _albedo                   N x 3         albedo     raw; colour max(0, Y00 a + 0.5) (surfel_shading.h)
-//   _features_dc_positive     N x 1 x 3  \  transfer_positive N x 27, the torch memory order of
-//   _features_rest_positive   N x 8 x 3  /  cat((dc, rest), 1): [k * 3 + c], k = SH coefficient, c = channel
-//   _features_dc/rest_negative            transfer_negative N x 27, same
-// Only channel 0 of a transfer set is ever read (2.1): transfer_channel0() gives those 9 scalars.
+// The trainable surfel model of the official LumiGauss (`scene/gaussian_model.py:GaussianModel`): the surfels
+// of model/surfel_model.h plus what only training needs, one Adam group per parameter, the gradient buffers,
+// the xyz learning-rate schedule and the densification bookkeeping (research/lumigauss_official.md 2.1, 5;
+// research/2dgs_rasterizer.md 6). A finished model is its SurfelModel part (slicing a GaussianModel into a
+// SurfelModel drops the optimizer state).
 // The official code has separate Adam groups for f_dc_* and f_rest_*; with one learning rate for both and
 // both always receiving gradients together, one group of 27 per side is element-for-element identical.
 #include <cstdint>
@@ -20,16 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "lumigauss/math/vec.h"
+#include "lumigauss/model/surfel_model.h"
 #include "lumigauss/render/raster_types.h"
 #include "lumigauss/train/adam.h"
 
 namespace lumigauss {
-
-enum class ModelParam { Xyz, Rotation, Scaling, Opacity, Albedo, TransferPositive, TransferNegative };
-inline constexpr int kModelParamCount = 7;
-inline constexpr int kTransferCoeffs = 9;                    // SH degree 2
-inline constexpr int kTransferStored = 3 * kTransferCoeffs;  // 27 floats per side as stored officially
 
 // Official defaults (training_setup, 5): xyz decays 1.6e-4 -> 1.6e-6 (x spatial_lr_scale) over 30000 steps.
 struct ModelLearningRates {
@@ -58,27 +44,22 @@ struct DensifyReport {
     std::size_t cloned = 0, split = 0, pruned = 0;
 };
 
-class GaussianModel {
+class GaussianModel : public SurfelModel {
   public:
-    static int width(ModelParam p);
-    static const char* name(ModelParam p);  // the official optimizer group name (transfer: "f_positive"...)
-
     GaussianModel() = default;
 
     // create_from_pcd + training_setup. point_rgb in [0, 1]. spatial_lr_scale = cameras_extent. Rotations
     // are random as officially, or with `orient_from_points` turned so that each surfel's normal is the
-    // normal of its point's neighbourhood (scene/point_normals.h).
+    // normal of its point's neighbourhood (model/point_normals.h).
     static GaussianModel from_points(const std::vector<Vec3f>& xyz, const std::vector<Vec3f>& rgb,
                                      double spatial_lr_scale, std::uint64_t seed,
                                      const ModelLearningRates& lr = {}, bool orient_from_points = false);
-    // Wraps existing raw parameters (e.g. a loaded PLY) with fresh optimizer state. Every vector must hold
-    // size * width(p) floats.
+    // Wraps a finished model (e.g. a loaded PLY) with fresh optimizer state.
+    static GaussianModel from_model(SurfelModel model, double spatial_lr_scale,
+                                    const ModelLearningRates& lr = {});
+    // The same from raw parameters: every vector must hold size * width(p) floats.
     static GaussianModel from_raw(std::vector<std::vector<float>> raw, double spatial_lr_scale,
                                   const ModelLearningRates& lr = {});
-
-    std::size_t size() const { return params_[0].size() / 3; }
-    std::vector<float>& param(ModelParam p) { return params_[int(p)]; }
-    const std::vector<float>& param(ModelParam p) const { return params_[int(p)]; }
     AdamGroup& adam(ModelParam p) { return adam_[int(p)]; }
     const AdamGroup& adam(ModelParam p) const { return adam_[int(p)]; }
     // The gradient buffer of a group; asking for it mutably marks the group as having a gradient this
@@ -89,12 +70,6 @@ class GaussianModel {
     const ModelLearningRates& learning_rates() const { return lr_; }
     double spatial_lr_scale() const { return spatial_lr_scale_; }
 
-    // Channel 0 of surfel i's transfer set: 9 scalars (the only ones the official shading reads).
-    void transfer_channel0(bool positive, std::size_t i, float out[kTransferCoeffs]) const;
-
-    // Geometry and opacity as the rasterizer takes them (exp scales, sigmoid opacity, raw quaternions).
-    // Colours are left to the caller: batch.colors is resized to batch.channels per surfel, not written.
-    void activated(SurfelBatch<float>& batch) const;
     // Chain rule from activated-value gradients into the raw-gradient buffers (added). Empty vectors in
     // `g` are skipped; colour and mean2d entries are not used here.
     void accumulate_grads_from_activated(const SurfelGrads<float>& g);
@@ -145,7 +120,6 @@ class GaussianModel {
     std::size_t split(const std::vector<float>& grads, double threshold, double extent, double percent_dense,
                       int children, std::uint64_t seed, bool reset_radii);
 
-    std::vector<float> params_[kModelParamCount];
     std::vector<float> grads_[kModelParamCount];
     bool has_grad_[kModelParamCount]{};
     AdamGroup adam_[kModelParamCount];
@@ -154,7 +128,5 @@ class GaussianModel {
     double spatial_lr_scale_ = 1;
     std::vector<float> grad_accum_, grad_count_, max_radii_;  // xyz_gradient_accum, denom, max_radii2D
 };
-
-float inverse_sigmoid(float p);
 
 }  // namespace lumigauss

@@ -1,4 +1,4 @@
-#include "lumigauss/scene/relightable_ply.h"
+#include "lumigauss/model/relightable_ply.h"
 
 #include <utility>
 #include <vector>
@@ -38,9 +38,9 @@ const std::vector<Field>& fields() {
     return f;
 }
 
-std::vector<float> column_of(const GaussianModel& m, const Field& f) {
+std::vector<float> column_of(const SurfelModel& m, const Field& f) {
     const auto& v = m.param(f.param);
-    const auto w = std::size_t(GaussianModel::width(f.param));
+    const auto w = std::size_t(SurfelModel::width(f.param));
     std::vector<float> col(m.size());
     for (std::size_t i = 0; i < col.size(); ++i) col[i] = v[i * w + std::size_t(f.offset)];
     return col;
@@ -48,7 +48,7 @@ std::vector<float> column_of(const GaussianModel& m, const Field& f) {
 
 }  // namespace
 
-void save_relightable_ply(const std::string& path, const GaussianModel& model) {
+void save_relightable_ply(const std::string& path, const SurfelModel& model) {
     PlyVertexTable table;
     table.count = model.size();
     const auto& f = fields();
@@ -59,20 +59,19 @@ void save_relightable_ply(const std::string& path, const GaussianModel& model) {
     write_ply_vertices(path, table);
 }
 
-GaussianModel load_relightable_ply(const std::string& path, double spatial_lr_scale,
-                                   const ModelLearningRates& lr) {
+SurfelModel load_relightable_ply(const std::string& path) {
     const PlyVertexTable table = read_ply_vertices(path);
     const std::size_t n = table.count;
     std::vector<std::vector<float>> raw(kModelParamCount);
     for (int p = 0; p < kModelParamCount; ++p)
-        raw[std::size_t(p)].resize(n * std::size_t(GaussianModel::width(ModelParam(p))));
+        raw[std::size_t(p)].resize(n * std::size_t(SurfelModel::width(ModelParam(p))));
     for (const Field& f : fields()) {
         const std::vector<float>& col = table.column(f.name, path);
-        const auto w = std::size_t(GaussianModel::width(f.param));
+        const auto w = std::size_t(SurfelModel::width(f.param));
         auto& dst = raw[std::size_t(f.param)];
         for (std::size_t i = 0; i < n; ++i) dst[i * w + std::size_t(f.offset)] = col[i];
     }
-    return GaussianModel::from_raw(std::move(raw), spatial_lr_scale, lr);
+    return SurfelModel::from_raw(std::move(raw));
 }
 
 }  // namespace lumigauss

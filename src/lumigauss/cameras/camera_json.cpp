@@ -1,4 +1,4 @@
-#include "lumigauss/relight/camera_json.h"
+#include "lumigauss/cameras/camera_json.h"
 
 #include <algorithm>
 #include <cmath>

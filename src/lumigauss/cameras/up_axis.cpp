@@ -1,4 +1,4 @@
-#include "lumigauss/relight/up_axis.h"
+#include "lumigauss/cameras/up_axis.h"
 
 #include <cctype>
 #include <cmath>

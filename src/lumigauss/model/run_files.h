@@ -1,0 +1,34 @@
+#pragma once
+// The files of a training run folder:
+//   config.json       the full TrainConfig (train/train_config.h), written when the run starts
+//   log.jsonl         one JSON object per logged iteration with every loss term (append-only)
+//   checkpoint.lgck   the latest checkpoint (train/checkpoint.h), replaced atomically
+//   model.ply         the surfels, official LumiGauss relightable PLY layout (relightable_ply.h)
+//   lighting.lgmlp    the lighting MLP and embedding table (lighting_mlp.h)
+//   appearance.json   the photo names in embedding-table order: {"images": [{"name": ..., "index": i}]}
+//   sky.lgsky         the per-photo sky residuals (sky_residual.h), when the run trained them
+// Every file is written atomically (temp + rename).
+#include <string>
+#include <vector>
+
+#include "lumigauss/model/lighting_mlp.h"
+#include "lumigauss/model/sky_residual.h"
+#include "lumigauss/model/surfel_model.h"
+
+namespace lumigauss {
+
+struct RunPaths {
+    std::string dir, config, log, checkpoint, model, lighting, appearance, sky;
+};
+RunPaths run_paths(const std::string& dir);
+
+// appearance.json for photos named in embedding order.
+void save_appearance(const std::string& path, const std::vector<std::string>& image_names);
+// The photo names of appearance.json, in embedding order. Throws Error naming the file if malformed.
+std::vector<std::string> load_appearance(const std::string& path);
+
+// model.ply, lighting.lgmlp, appearance.json and (when not empty) sky.lgsky.
+void save_run_model(const RunPaths& paths, const SurfelModel& model, const LightingMlp& lighting,
+                    const std::vector<std::string>& image_names, const SkyResiduals& sky_residuals);
+
+}  // namespace lumigauss
