@@ -25,6 +25,7 @@
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/render/rasterizer.h"
 #include "lumigauss/util/error.h"
+#include "lumigauss/util/text.h"
 
 namespace lumigauss::cli {
 namespace {
@@ -41,10 +42,6 @@ struct EvalOptions {
     std::string via = "auto";
     int fit_iterations = 300;
 };
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // -r when given, else the run's training resolution (1 when the run does not record it).
 DatasetOptions evaluated_resolution(const EvalOptions& o, int run_downscale) {

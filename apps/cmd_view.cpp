@@ -1,7 +1,7 @@
 // `lumigauss view SOURCE [--port P] [--light L ...]`: serves the real-time relighting viewer (web/viewer/,
 // embedded in the binary) for a trained run or a bare relightable PLY on http://127.0.0.1:P/ until Ctrl-C.
 // The page renders in WebGL2: orbit camera, environment from the training photos' learned lightings or an SH
-// file, environment rotation, shadowed/unshadowed/albedo/normals/shadow views (src/lumigauss/view/).
+// file, environment rotation, shadowed/unshadowed/albedo/normals/shadow views (src/lumigauss/viewer/).
 #include <csignal>
 #include <cstdio>
 #include <memory>
@@ -14,10 +14,10 @@
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_source.h"
 #include "lumigauss/util/error.h"
-#include "lumigauss/view/http_server.h"
-#include "lumigauss/view/model_payload.h"
-#include "lumigauss/view/scene_info.h"
-#include "lumigauss/view/viewer_site.h"
+#include "lumigauss/viewer/http_server.h"
+#include "lumigauss/viewer/model_payload.h"
+#include "lumigauss/viewer/scene_info.h"
+#include "lumigauss/viewer/viewer_site.h"
 
 namespace lumigauss::cli {
 namespace {

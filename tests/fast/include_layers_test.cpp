@@ -18,12 +18,12 @@ namespace fs = std::filesystem;
 
 // Lowest first. A folder may include its own layer's folders and every lower layer's.
 const std::vector<std::vector<std::string>> kLayers = {
-    {"util", "math"},                      // no project dependencies beyond each other
-    {"io"},                                // files, images, datasets, image metrics
-    {"shading", "render"},                 // SH lighting; the rasterizer and its backends (render/cpu, cuda)
-    {"model", "cameras"},                  // the finished relightable model; camera paths and frames
-    {"train", "synth"},                    // optimisation; the synthetic scene generator
-    {"eval", "relight", "export", "view"}  // what users run on a model
+    {"util", "math"},       // no project dependencies beyond each other
+    {"io"},                 // files, images, datasets, image metrics
+    {"shading", "render"},  // SH lighting; the rasterizer and its backends (render/cpu, cuda)
+    {"model", "cameras"},   // the finished relightable model; camera paths and frames
+    {"train", "synth"},     // optimisation; the synthetic scene generator
+    {"eval", "relight", "export", "viewer"}  // what users run on a model
 };
 
 int layer_of(const std::string& folder) {

@@ -14,6 +14,7 @@
 #include "lumigauss/render/raster_maps.h"
 #include "lumigauss/shading/sh_rotation.h"
 #include "lumigauss/util/error.h"
+#include "lumigauss/util/text.h"
 
 namespace lumigauss {
 namespace {
@@ -27,10 +28,6 @@ double ms_since(Clock::time_point t0) {
 
 double radians(double degrees) {
     return degrees * std::numbers::pi / 180.0;
-}
-
-std::string stem_of(const std::string& name) {
-    return fs::path(name).replace_extension().string();
 }
 
 // The configured file, or an Error naming the first place looked at (and the others).
@@ -165,7 +162,7 @@ const View* find_sol_nerf_view(const Dataset& scene, const std::string& name) {
         if (v.name == name) return &v;
     const View* found = nullptr;
     for (const View& v : scene.views)
-        if (stem_of(v.name) == stem_of(name)) {
+        if (without_extension(v.name) == without_extension(name)) {
             if (found) return nullptr;
             found = &v;
         }

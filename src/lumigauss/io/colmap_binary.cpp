@@ -169,10 +169,6 @@ void put(std::string& out, T value) {
     out.append(bytes, sizeof(T));
 }
 
-std::uint8_t to_byte(float c) {
-    return std::uint8_t(std::lround(std::fmin(std::fmax(c, 0.0f), 1.0f) * 255.0f));
-}
-
 }  // namespace
 
 ColmapModel read_colmap_binary(const std::string& dir) {
@@ -210,7 +206,7 @@ void write_colmap_binary(const std::string& dir, const ColmapModel& model) {
         put<std::uint64_t>(pts, i + 1);
         for (int k = 0; k < 3; ++k) put<double>(pts, model.point_xyz[i][k]);
         const Vec3f rgb = i < model.point_rgb.size() ? model.point_rgb[i] : Vec3f{};
-        for (int k = 0; k < 3; ++k) put<std::uint8_t>(pts, to_byte(rgb[k]));
+        for (int k = 0; k < 3; ++k) put<std::uint8_t>(pts, colmap_detail::colour_byte(rgb[k]));
         put<double>(pts, 0.0);       // reprojection error
         put<std::uint64_t>(pts, 0);  // empty track
     }

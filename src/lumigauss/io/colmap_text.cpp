@@ -174,10 +174,6 @@ void append(std::string& out, const Parts&... parts) {
     (put(out, parts), ...);
 }
 
-int to_byte(float c) {
-    return int(std::lround(std::fmin(std::fmax(c, 0.0f), 1.0f) * 255.0f));
-}
-
 std::string cameras_text(const ColmapModel& model) {
     std::string out =
         "# Camera list with one line of data per camera:\n#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n";
@@ -215,7 +211,7 @@ std::string points_text(const ColmapModel& model) {
         put(out, i + 1);
         for (int k = 0; k < 3; ++k) append(out, " ", model.point_xyz[i][k]);
         const Vec3f rgb = i < model.point_rgb.size() ? model.point_rgb[i] : Vec3f{};
-        for (int k = 0; k < 3; ++k) append(out, " ", to_byte(rgb[k]));
+        for (int k = 0; k < 3; ++k) append(out, " ", int(colmap_detail::colour_byte(rgb[k])));
         put(out, " 0\n");
     }
     return out;

@@ -6,16 +6,11 @@
 #include <optional>
 
 #include "lumigauss/util/error.h"
+#include "lumigauss/util/text.h"
 
 namespace lumigauss {
 
 namespace {
-
-std::string trim(const std::string& s) {
-    const auto first = s.find_first_not_of(" \t\r");
-    if (first == std::string::npos) return {};
-    return s.substr(first, s.find_last_not_of(" \t\r") - first + 1);
-}
 
 std::optional<Split> parse_split(std::string s) {
     std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
@@ -40,11 +35,12 @@ std::map<std::string, Split> read_split_file(const std::string& path) {
     std::string line;
     bool first_record = true;
     for (int number = 1; std::getline(in, line); ++number) {
-        if (trim(line).empty()) continue;
+        if (trim_whitespace(line).empty()) continue;
         const std::string where = "line " + std::to_string(number) + ": ";
         const auto sep = line.find(separator_of(line));
         if (sep == std::string::npos) fail_in_file(path, where + "expected `filename;split`");
-        const std::string name = trim(line.substr(0, sep)), value = trim(line.substr(sep + 1));
+        const std::string name(trim_whitespace(line.substr(0, sep))),
+            value(trim_whitespace(line.substr(sep + 1)));
         const auto split = parse_split(value);
         const bool header = first_record && !split;
         first_record = false;

@@ -13,6 +13,7 @@
 #include "lumigauss/relight/video.h"
 #include "lumigauss/shading/sky_image.h"
 #include "lumigauss/util/error.h"
+#include "lumigauss/util/text.h"
 
 namespace lumigauss {
 namespace {
@@ -21,12 +22,6 @@ namespace fs = std::filesystem;
 
 bool is_split_keyword(const std::string& s) {
     return s == "train" || s == "test" || s == "validation" || s == "all";
-}
-
-std::string stem_of(const std::string& image_name) {
-    fs::path p(image_name);
-    p.replace_extension();
-    return p.generic_string();
 }
 
 // Keeps the cameras whose name (or original image name) is listed; every listed name must match.
@@ -111,7 +106,7 @@ RelightCameras relight_cameras(const RelightJob& job, const TrainedRun& run) {
     std::vector<std::string> image_names;
     for (const View& v : scene.views) {
         if (job.cameras != "all" && job.cameras != split_name(v.split)) continue;
-        rc.cameras.push_back({stem_of(v.name), v.camera});
+        rc.cameras.push_back({without_extension(v.name), v.camera});
         image_names.push_back(v.name);
     }
     if (rc.cameras.empty())

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "lumigauss/util/error.h"
+#include "lumigauss/util/text.h"
 
 namespace lumigauss {
 namespace {
@@ -284,14 +285,6 @@ void set_from_json(TrainConfig& config, const Field& field, const Json& value, s
 // ---- Text values (--set)
 // ------------------------------------------------------------------------------------
 
-std::string_view trim(std::string_view s) {
-    constexpr std::string_view kSpace = " \t\r\n";
-    const std::size_t first = s.find_first_not_of(kSpace);
-    if (first == std::string_view::npos) return {};
-    const std::size_t last = s.find_last_not_of(kSpace);
-    return s.substr(first, last - first + 1);
-}
-
 template <class Number>
 bool parse_number(std::string_view text, Number& out) {
     // from_chars rejects a leading '+', which people write; accept exactly one.
@@ -451,8 +444,8 @@ void apply_train_config_override(TrainConfig& config, std::string_view key_equal
     if (eq == std::string_view::npos) {
         throw Error(source + ": expected key=value (for example --set iterations=3000)");
     }
-    const std::string_view key = trim(key_equals_value.substr(0, eq));
-    const std::string_view value = trim(key_equals_value.substr(eq + 1));
+    const std::string_view key = trim_whitespace(key_equals_value.substr(0, eq));
+    const std::string_view value = trim_whitespace(key_equals_value.substr(eq + 1));
     if (key.empty()) throw Error(source + ": expected key=value, the key is empty");
     if (key == "preset") {
         config = preset_for_key(value, source);

@@ -16,6 +16,7 @@
 #include "lumigauss/train/view_shading_backward.h"
 #include "lumigauss/util/error.h"
 #include "lumigauss/util/rng.h"
+#include "lumigauss/util/text.h"
 
 namespace lumigauss {
 namespace {
@@ -26,10 +27,6 @@ constexpr std::uint64_t kEnvNoise = 0x656e766e6f697365ULL;     // "envnoise"
 constexpr std::uint64_t kDensify = 0x64656e736966ULL;          // "densif"
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-    return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 }  // namespace
 

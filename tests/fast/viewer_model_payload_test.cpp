@@ -1,6 +1,6 @@
-// view/model_payload.h and view/scene_info.h: what the viewer's page downloads. The payload is decoded here
-// by a reader written from the documented layout alone, and must give back the model's raw parameters bit
-// for bit; the scene description lists the lights in the documented order.
+// viewer/model_payload.h and viewer/scene_info.h: what the viewer's page downloads. The payload is decoded
+// here by a reader written from the documented layout alone, and must give back the model's raw parameters
+// bit for bit; the scene description lists the lights in the documented order.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -13,8 +13,8 @@
 #include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/util/error.h"
-#include "lumigauss/view/model_payload.h"
-#include "lumigauss/view/scene_info.h"
+#include "lumigauss/viewer/model_payload.h"
+#include "lumigauss/viewer/scene_info.h"
 #include "relight_test_util.h"
 #include "support/random_surfels.h"
 

@@ -1,4 +1,4 @@
-#include "lumigauss/view/viewer_assets.h"
+#include "lumigauss/viewer/viewer_assets.h"
 
 #include <utility>
 

@@ -15,7 +15,7 @@
 #include <memory>
 #include <string>
 
-#include "lumigauss/view/http_message.h"
+#include "lumigauss/viewer/http_message.h"
 
 namespace lumigauss::view {
 

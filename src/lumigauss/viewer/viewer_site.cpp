@@ -1,10 +1,10 @@
-#include "lumigauss/view/viewer_site.h"
+#include "lumigauss/viewer/viewer_site.h"
 
 #include <nlohmann/json.hpp>
 
 #include "lumigauss/io/atomic_file.h"
-#include "lumigauss/view/url_path.h"
-#include "lumigauss/view/viewer_assets.h"
+#include "lumigauss/viewer/url_path.h"
+#include "lumigauss/viewer/viewer_assets.h"
 
 namespace lumigauss::view {
 

@@ -1,4 +1,4 @@
-#include "lumigauss/view/url_path.h"
+#include "lumigauss/viewer/url_path.h"
 
 #include <algorithm>
 #include <string>

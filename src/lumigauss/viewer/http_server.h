@@ -18,7 +18,7 @@
 #include <list>
 #include <thread>
 
-#include "lumigauss/view/http_message.h"
+#include "lumigauss/viewer/http_message.h"
 
 namespace lumigauss::view {
 

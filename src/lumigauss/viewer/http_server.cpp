@@ -1,4 +1,4 @@
-#include "lumigauss/view/http_server.h"
+#include "lumigauss/viewer/http_server.h"
 
 #include <arpa/inet.h>
 #include <fcntl.h>

@@ -1,4 +1,4 @@
-#include "lumigauss/view/model_payload.h"
+#include "lumigauss/viewer/model_payload.h"
 
 #include <bit>
 #include <cstring>

@@ -1,10 +1,10 @@
-// view/url_path.h: the viewer's request targets are decoded so that nothing outside the served content can
+// viewer/url_path.h: the viewer's request targets are decoded so that nothing outside the served content can
 // be named (traversal, encoded separators, NUL, absolute forms are refused).
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "lumigauss/view/url_path.h"
+#include "lumigauss/viewer/url_path.h"
 
 namespace lumigauss::view {
 namespace {

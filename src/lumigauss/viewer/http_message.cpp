@@ -1,4 +1,4 @@
-#include "lumigauss/view/http_message.h"
+#include "lumigauss/viewer/http_message.h"
 
 #include <algorithm>
 #include <cctype>
@@ -18,7 +18,8 @@ bool has_control_byte(std::string_view s) {
     });
 }
 
-std::string_view trim(std::string_view s) {
+// HTTP optional whitespace (RFC 9110 5.6.3): spaces and tabs only.
+std::string_view trim_ows(std::string_view s) {
     while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
     while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
     return s;
@@ -43,7 +44,7 @@ bool parse_header_line(std::string_view line, HttpRequest& out) {
     if (colon == std::string_view::npos || colon == 0) return false;
     const std::string_view name = line.substr(0, colon);
     if (!std::all_of(name.begin(), name.end(), is_token_char)) return false;
-    const std::string_view value = trim(line.substr(colon + 1));
+    const std::string_view value = trim_ows(line.substr(colon + 1));
     if (has_control_byte(value)) return false;
     std::string lower(name);
     for (char& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));

@@ -1,4 +1,4 @@
-// view/http_server.h + view/viewer_site.h: the viewer's server listens on 127.0.0.1 only, serves exactly
+// viewer/http_server.h + viewer/viewer_site.h: the viewer's server listens on 127.0.0.1 only, serves exactly
 // the embedded assets and the generated payloads with the right types, refuses traversal attempts and any
 // method but GET/HEAD, and stops cleanly.
 #include <arpa/inet.h>
@@ -18,11 +18,11 @@
 #include <thread>
 
 #include "lumigauss/util/error.h"
-#include "lumigauss/view/http_server.h"
-#include "lumigauss/view/model_payload.h"
-#include "lumigauss/view/scene_info.h"
-#include "lumigauss/view/viewer_assets.h"
-#include "lumigauss/view/viewer_site.h"
+#include "lumigauss/viewer/http_server.h"
+#include "lumigauss/viewer/model_payload.h"
+#include "lumigauss/viewer/scene_info.h"
+#include "lumigauss/viewer/viewer_assets.h"
+#include "lumigauss/viewer/viewer_site.h"
 #include "relight_test_util.h"
 #include "support/random_surfels.h"
 #include "support/temp_dir.h"

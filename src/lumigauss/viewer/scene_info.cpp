@@ -1,4 +1,4 @@
-#include "lumigauss/view/scene_info.h"
+#include "lumigauss/viewer/scene_info.h"
 
 #include <algorithm>
 #include <filesystem>
