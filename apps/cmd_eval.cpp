@@ -70,8 +70,11 @@ void run_gt_env(const EvalOptions& o) {
     write_gt_env_report(o.out, result, {o.run, o.scene}, !o.no_sheets);
     const double s = seconds_since(t0);
     if (!o.quiet) {
-        std::printf("  light scale k = %.6g (fit on %zu training photos, relative residual %.3f)\n",
-                    result.light.scale, result.light.per_photo.size(), result.light.relative_residual);
+        if (run.image_names.empty())
+            std::printf("  light scale k = 1 (a bare PLY: no learned lights to fit it on)\n");
+        else
+            std::printf("  light scale k = %.6g (fit on %zu training photos, relative residual %.3f)\n",
+                        result.light.scale, result.light.per_photo.size(), result.light.relative_residual);
         for (const GtEnvImageResult& im : result.images)
             std::printf("  %-24s %-14s shadowed PSNR %6.2f SSIM %.4f | unshadowed PSNR %6.2f SSIM %.4f\n",
                         im.name.c_str(), im.condition.c_str(), im.shadowed.psnr, im.shadowed.ssim,

@@ -118,6 +118,24 @@ TEST(CliEval, TrainViewsDiagnostic) {
     EXPECT_EQ(j["light_scale"]["train_photos"], appearance["images"].size());
 }
 
+// A bare relightable PLY (e.g. from the official code) is evaluated too: it has no learned lights, so the
+// light scale is 1 and the scores are those of the run's surfels under the true lights.
+TEST(CliEval, BarePlyIsEvaluatedWithLightScaleOne) {
+    const TinyRun& t = tiny_run();
+    ASSERT_EQ(t.train_exit, 0) << t.train_output;
+    TempDir tmp("cli_eval_bare_ply");
+    const std::string ply = tmp / "bare.ply";
+    fs::copy_file(t.run + "/model.ply", ply);
+    const CommandResult r =
+        run_lumigauss("eval " + shell_quoted(ply) + " --scene " + shell_quoted(t.scene) +
+                          " --protocol gt-env --no-sheets -o " + shell_quoted(tmp / "report"),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("light scale k = 1 (a bare PLY"));
+    const nlohmann::json m = synth_test::read_json(tmp / "report/metrics.json");
+    EXPECT_EQ(m["light_scale"]["value"].get<double>(), 1.0);
+}
+
 TEST(CliEval, MissingModelIsNamed) {
     const TinyRun& t = tiny_run();
     ASSERT_EQ(t.train_exit, 0) << t.train_output;

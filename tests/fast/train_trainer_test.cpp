@@ -511,12 +511,10 @@ std::optional<NonFiniteError> non_finite_step(Trainer& trainer) {
     return std::nullopt;
 }
 
-// KNOWN BUG (fails; left in place on purpose): a NaN raw albedo is never detected. albedo_activation
-// (src/lumigauss/shading/surfel_shading.h, `r[c] = v > T(0) ? v : T(0)`) maps NaN to 0 and its VJP gives a 0
-// gradient, so the loss and every gradient stay finite, step() does not throw, and the NaN stays in the
-// model for good (and would be written to model.ply). torch's clamp/relu propagate NaN, so the official code
-// gets a NaN loss here. Measured: NaN in the green albedo of every surfel trains 195 more iterations without
-// an error (PSNR 11.8 dB, the NaN still in the parameters).
+// Regression test of a fixed bug: a NaN raw albedo went undetected while albedo_activation
+// (shading/surfel_shading.h) mapped NaN to 0 with a 0 gradient, so the NaN stayed in the model (a probe trained
+// 195 more iterations with it). The activation now lets NaN through, as torch's clamp does, and the loss
+// reports it.
 TEST(TrainTrainer, NanAlbedoThrowsNonFiniteErrorWithoutAdvancing) {
     TrainConfig config = train_preset("paper-fast");
     config.iterations = 20;
@@ -545,11 +543,9 @@ TEST(TrainTrainer, NanAlbedoThrowsNonFiniteErrorWithoutAdvancing) {
     EXPECT_THAT(e->what(), HasSubstr(e->term));
 }
 
-// KNOWN BUG (fails; left in place on purpose): a NaN environment coefficient is never detected. The
-// irradiance is NaN, light_intensity (surfel_shading.h, `h > floor ? h : floor`) turns it into the 1e-5
-// floor, light_to_colour_vjp returns a 0 gradient for it, and l_+ skips NaN radiance values (NaN < 0 is
-// false); so the loss and all gradients are finite, step() does not throw, and the NaN bias stays in the
-// lighting MLP (195 more iterations ran without an error in a probe).
+// Regression test of a fixed bug: a NaN environment coefficient went undetected while light_intensity
+// (surfel_shading.h) turned a NaN irradiance into its 1e-5 floor with a 0 gradient and l_+ skipped NaN
+// radiance. NaN now passes through light_intensity, so the loss reports it.
 TEST(TrainTrainer, NanLightingThrowsNonFiniteErrorWithoutAdvancing) {
     TrainConfig config = train_preset("paper-fast");
     config.iterations = 20;

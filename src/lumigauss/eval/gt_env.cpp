@@ -145,10 +145,10 @@ ShCoeffs<double> load_condition_sh(const GtSceneMeta& meta, const std::string& c
 
 // ---- Run ----------------------------------------------------------------------------------------------
 
-RelightableRun load_relightable_run(const std::string& dir) {
-    TrainedRun trained = load_trained_run(dir);
+RelightableRun load_relightable_run(const std::string& path) {
+    TrainedRun trained = load_run_or_ply(path);
     RelightableRun run;
-    run.dir = dir;
+    run.dir = trained.dir;
     run.model = std::move(trained.model);
     run.image_names = std::move(trained.image_names);
     for (int i = 0; i < trained.lighting.num_images(); ++i) run.learned_sh.push_back(trained.learned_sh(i));
@@ -229,6 +229,7 @@ LightScaleFit fit_light_scale(const std::vector<ShCoeffs<double>>& learned,
 
 LightScaleFit fit_run_light_scale(const RelightableRun& run, const GtSceneMeta& meta,
                                   const std::vector<std::string>& exclude) {
+    if (run.image_names.empty()) return {};  // a bare PLY: no learned light to scale
     std::vector<ShCoeffs<double>> learned, truth;
     std::vector<double> exposure;
     std::vector<std::string> names;

@@ -82,9 +82,10 @@ struct RelightableRun {
     bool sky_background = false;               // trained with the photo's sky behind the surfels
 };
 
-// model.ply, lighting.lgmlp, appearance.json (and config.json if present) of a run folder. Throws Error
-// naming the first missing or malformed file.
-RelightableRun load_relightable_run(const std::string& dir);
+// A run folder (model.ply, lighting.lgmlp, appearance.json and config.json if present) or a bare relightable
+// PLY (model/trained_run.h's load_run_or_ply: no photos, so no learned lights). Throws Error naming the
+// first missing or malformed file.
+RelightableRun load_relightable_run(const std::string& path);
 
 // A relightable model with the geometry and colour of a 2DGS surfel model (e.g. gt/surfels.ply, whose colour
 // is the linear albedo rho): model albedo = (rho / pi)^(1/2.2), so that with learned SH = exposure * true SH
@@ -112,7 +113,7 @@ LightScaleFit fit_light_scale(const std::vector<ShCoeffs<double>>& learned,
 
 // The run's training photos found in meta.json with split "train" and not in `exclude` (evaluate_gt_env
 // passes the test views it evaluates): a test photo never enters the fit. Throws Error naming meta.json
-// when no photo is left.
+// when no photo is left. A bare PLY (no photos, no learned lights) has nothing to fit: k = 1, no names.
 LightScaleFit fit_run_light_scale(const RelightableRun& run, const GtSceneMeta& meta,
                                   const std::vector<std::string>& exclude = {});
 
