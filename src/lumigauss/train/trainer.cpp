@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "lumigauss/io/image_metrics.h"
 #include "lumigauss/io/scene_extent.h"
 #include "lumigauss/render/background.h"
 #include "lumigauss/render/rasterizer.h"
@@ -95,8 +96,9 @@ double masked_psnr(std::span<const float> rendered, std::span<const float> targe
         }
         weight += 3.0 * double(mask[p]);
     }
-    const double mse = weight > 0 ? err / weight : 0.0;
-    return -10.0 * std::log10(mse + 1e-10);
+    // The evaluation's PSNR (io/image_metrics.h: the same epsilon and formula) of the render the losses see,
+    // unclamped.
+    return psnr_from_mse(weight > 0 ? err / weight : 0.0);
 }
 
 bool all_finite(std::span<const float> v) {
