@@ -1,6 +1,7 @@
 // `lumigauss train <scene> -o <run>`: trains a relightable surfel model with the three-stage LumiGauss
 // schedule, with a progress line, a JSON-lines log of every loss term, atomic checkpoints (at intervals, on
-// Ctrl-C and before stopping on a non-finite value) and exact --resume.
+// Ctrl-C and before stopping on a non-finite value) and exact --resume. The run's life is the library's
+// (train/training_run.h); this file parses the flags, prints, and turns Ctrl-C into a stop request.
 #include <sys/resource.h>
 #include <tbb/global_control.h>
 #include <unistd.h>
@@ -16,19 +17,11 @@
 #include <memory>
 
 #include "commands.h"
-#include "lumigauss/io/atomic_file.h"
 #include "lumigauss/io/dataset.h"
-#include "lumigauss/io/image.h"
 #include "lumigauss/io/text_file.h"
-#include "lumigauss/model/render_model.h"
-#include "lumigauss/render/background.h"
-#include "lumigauss/render/raster_maps.h"
 #include "lumigauss/render/rasterizer.h"
-#include "lumigauss/shading/sky_image.h"
-#include "lumigauss/shading/surfel_shading.h"
-#include "lumigauss/train/checkpoint.h"
-#include "lumigauss/train/run_folder.h"
 #include "lumigauss/train/trainer.h"
+#include "lumigauss/train/training_run.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss::cli {
@@ -61,20 +54,6 @@ TrainConfig config_from_flags(const TrainFlags& f) {
     if (f.downscale > 0) c.downscale = f.downscale;
     validate_train_config(c);
     return c;
-}
-
-// Keeps the log lines up to `iteration` (a resumed run rewrites what followed its checkpoint).
-void truncate_log(const std::string& path, std::int64_t iteration) {
-    std::ifstream in(path);
-    if (!in) return;
-    std::string kept, line;
-    const std::string key = "\"iteration\":";
-    while (std::getline(in, line)) {
-        const auto pos = line.find(key);
-        if (pos == std::string::npos) continue;
-        if (std::stoll(line.substr(pos + key.size())) <= iteration) kept += line + "\n";
-    }
-    write_file_atomically(path, kept);
 }
 
 class Progress {
@@ -124,141 +103,61 @@ class Progress {
     std::deque<double> psnr_;
 };
 
-// previews/NAME.png for the first few training photos: the photo, the shadowed and the unshadowed render
-// under the photo's learned environment, side by side (values clipped to [0, 1]).
-void write_previews(const std::string& dir, const Trainer& trainer, int count) {
-    const auto& views = trainer.views();
-    std::filesystem::create_directories(dir);
-    for (int v = 0; v < std::min<int>(count, int(views.size())); ++v) {
-        const TrainView& view = views[std::size_t(v)];
-        const ShCoeffs<float> env = trainer.state().lighting.env_sh(v);
-        RasterImages<float> img =
-            render_with_environment(trainer.state().model, view.camera, env, ShadingMode::Both);
-        if (trainer.state().config.sky_background) {
-            const TrainState& st = trainer.state();
-            const Sh4Coeffs<float> residual =
-                st.sky_residuals.empty() ? Sh4Coeffs<float>{} : st.sky_residuals.get(v);
-            const Image sky = sky_image(view.camera, env, st.sky_residuals.empty() ? nullptr : &residual);
-            for (int first : {kShadowedOffset, kUnshadowedOffset})
-                composite_background<float>(img, sky.pixels, first);
-        }
-        const Image shadowed = raster_channels(img, kShadowedOffset, 3);
-        const Image unshadowed = raster_channels(img, kUnshadowedOffset, 3);
-        const Image* panels[3] = {&view.rgb, &shadowed, &unshadowed};
-        const int w = view.rgb.width, h = view.rgb.height;
-        Image out(3 * w, h, 3);
-        for (int k = 0; k < 3; ++k)
-            for (int y = 0; y < h; ++y)
-                for (int x = 0; x < w; ++x)
-                    for (int c = 0; c < 3; ++c)
-                        out.at(k * w + x, y, c) = std::clamp(panels[k]->at(x, y, c), 0.0f, 1.0f);
-        std::filesystem::path name = std::filesystem::path(dir) / view.name;
-        name.replace_extension(".png");
-        std::filesystem::create_directories(name.parent_path());
-        write_png(name.string(), out);
-    }
-}
-
-void checkpoint(const RunPaths& paths, const TrainState& state) {
-    save_checkpoint(paths.checkpoint, state);
-}
-
 int run_train(const TrainFlags& f) {
-    const RasterBackend backend = choose_backend(f.backend);  // before anything is read or written
+    TrainingRunRequest request;
+    request.backend = choose_backend(f.backend);  // before anything is read or written
     std::unique_ptr<tbb::global_control> threads;
     if (f.threads > 0)
         threads =
             std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, f.threads);
-    const RunPaths paths = run_paths(f.out);
-    std::unique_ptr<Trainer> trainer;
+    request.scene = f.scene, request.out = f.out;
+    request.resume = f.resume, request.force = f.force;
     if (f.resume) {
-        if (!std::filesystem::exists(paths.checkpoint))
-            fail_in_file(paths.checkpoint, "no checkpoint to resume from (start the run without --resume)");
         if (!f.config_file.empty() || !f.overrides.empty() || f.downscale > 0)
             throw Error("--resume continues with the saved config; only --iterations may change");
-        TrainState state = load_checkpoint(paths.checkpoint);
-        if (f.iterations > 0) {
-            if (f.iterations < state.iteration)
-                fail_in_file(paths.checkpoint, "the run is already at iteration " +
-                                                   std::to_string(state.iteration) +
-                                                   "; --iterations must not be smaller");
-            state.config.iterations = f.iterations;
-        }
-        DatasetOptions dopt;
-        dopt.downscale = state.config.downscale;
-        const Dataset data = load_dataset(f.scene, dopt);
-        trainer = std::make_unique<Trainer>(load_train_views(data), std::move(state));
-        truncate_log(paths.log, trainer->iteration());
-        std::printf("train: resuming %s at iteration %lld of %lld\n", f.out.c_str(),
-                    (long long)trainer->iteration(), (long long)trainer->state().config.iterations);
+        request.resume_iterations = f.iterations;
     } else {
-        const TrainConfig config = config_from_flags(f);
-        if (std::filesystem::exists(paths.checkpoint) && !f.force)
-            fail_in_file(paths.checkpoint,
-                         "a run already exists here; continue it with --resume or replace it with --force");
-        DatasetOptions dopt;
-        dopt.downscale = config.downscale;
-        const Dataset data = load_dataset(f.scene, dopt);
-        trainer = std::make_unique<Trainer>(load_train_views(data), data.point_xyz, data.point_rgb, config);
-        std::filesystem::create_directories(f.out);  // only once the input is known to be good
-        write_file_atomically(paths.config, train_config_to_json(config));
-        write_file_atomically(paths.log, "");
-        std::printf("train: %zu photos, %zu SfM points, preset %s, %lld iterations -> %s\n",
-                    trainer->views().size(), data.point_xyz.size(), config.preset.c_str(),
-                    (long long)config.iterations, f.out.c_str());
-        std::fflush(stdout);
+        request.config = config_from_flags(f);
     }
-    trainer->set_backend(backend);
-    if (backend != RasterBackend::Cpu && !f.quiet)
-        std::printf("train: rasterizing on %s\n", backend_description(backend).c_str());
-    const TrainConfig& config = trainer->state().config;
+    TrainingRun run(request);
+    const Trainer& trainer = run.trainer();
+    const TrainConfig& config = trainer.state().config;
+    const RunPaths& paths = run.paths();
+    if (run.resumed())
+        std::printf("train: resuming %s at iteration %lld of %lld\n", f.out.c_str(),
+                    (long long)trainer.iteration(), (long long)config.iterations);
+    else
+        std::printf("train: %zu photos, %zu SfM points, preset %s, %lld iterations -> %s\n",
+                    trainer.views().size(), run.sfm_points(), config.preset.c_str(),
+                    (long long)config.iterations, f.out.c_str());
+    std::fflush(stdout);
+    if (request.backend != RasterBackend::Cpu && !f.quiet)
+        std::printf("train: rasterizing on %s\n", backend_description(request.backend).c_str());
     std::signal(SIGINT, on_interrupt);
     std::signal(SIGTERM, on_interrupt);
-    std::ofstream log(paths.log, std::ios::app);
-    Progress progress(trainer->iteration(), config.iterations, f.quiet);
-    const auto t0 = std::chrono::steady_clock::now();
-    auto elapsed = [&] {
-        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    };
-    while (!trainer->done()) {
-        if (g_interrupted || (f.stop_after > 0 && trainer->iteration() >= f.stop_after)) {
-            progress.finish();
-            checkpoint(paths, trainer->state());
-            std::printf("train: stopped at iteration %lld; checkpoint %s (continue with --resume)\n",
-                        (long long)trainer->iteration(), paths.checkpoint.c_str());
-            return g_interrupted ? 130 : 0;
-        }
-        StepReport r;
-        try {
-            r = trainer->step();
-        } catch (const NonFiniteError& e) {
-            progress.finish();
-            checkpoint(paths, trainer->state());
-            std::fprintf(
-                stderr,
-                "error: %s. Stopped; the last good state (iteration %lld) is in %s. Lower the learning "
-                "rates or check the input photos, then continue with --resume.\n",
-                e.what(), (long long)trainer->iteration(), paths.checkpoint.c_str());
-            return 3;
-        }
-        const bool log_now =
-            r.iteration % config.log_interval == 0 || r.densify_ran || r.prune_ran || trainer->done();
-        if (log_now) log << step_log_line(r, elapsed()) << '\n' << std::flush;
-        progress.update(r, trainer->done());
-        if (config.checkpoint_interval > 0 && r.iteration % config.checkpoint_interval == 0 &&
-            !trainer->done())
-            checkpoint(paths, trainer->state());
-    }
+    Progress progress(trainer.iteration(), config.iterations, f.quiet);
+    const TrainingOutcome outcome = run.run(
+        f.stop_after, [] { return g_interrupted.load(); },
+        [&](const StepReport& r) { progress.update(r, trainer.done()); });
     progress.finish();
-    checkpoint(paths, trainer->state());
-    save_run_model(paths, trainer->state());
-    write_previews((std::filesystem::path(f.out) / "previews").string(), *trainer, 4);
-    const auto& t = trainer->phase_times();
+    if (outcome == TrainingOutcome::Stopped) {
+        std::printf("train: stopped at iteration %lld; checkpoint %s (continue with --resume)\n",
+                    (long long)trainer.iteration(), paths.checkpoint.c_str());
+        return g_interrupted ? 130 : 0;
+    }
+    if (outcome == TrainingOutcome::NonFinite) {
+        std::fprintf(stderr,
+                     "error: %s. Stopped; the last good state (iteration %lld) is in %s. Lower the learning "
+                     "rates or check the input photos, then continue with --resume.\n",
+                     run.failure().c_str(), (long long)trainer.iteration(), paths.checkpoint.c_str());
+        return 3;
+    }
+    const auto& t = trainer.phase_times();
     std::printf(
         "train: done, %lld iterations in %s, %zu surfels, training PSNR %.2f dB (last 50), peak memory %.0f "
         "MiB\n",
-        (long long)config.iterations, Progress::duration(elapsed()).c_str(), trainer->state().model.size(),
-        progress.mean_psnr(), peak_memory_mib());
+        (long long)config.iterations, Progress::duration(run.elapsed_seconds()).c_str(),
+        trainer.state().model.size(), progress.mean_psnr(), peak_memory_mib());
     std::printf(
         "train: time in shading %.1fs, raster fwd %.1fs, losses %.1fs, raster bwd %.1fs, shading bwd %.1fs, "
         "physical %.1fs, optimizer %.1fs, densify %.1fs\n",

@@ -1,0 +1,148 @@
+#include "lumigauss/train/training_run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+
+#include "lumigauss/io/atomic_file.h"
+#include "lumigauss/io/dataset.h"
+#include "lumigauss/io/image.h"
+#include "lumigauss/model/render_model.h"
+#include "lumigauss/render/background.h"
+#include "lumigauss/render/raster_maps.h"
+#include "lumigauss/shading/sky_image.h"
+#include "lumigauss/shading/surfel_shading.h"
+#include "lumigauss/train/checkpoint.h"
+#include "lumigauss/train/run_folder.h"
+#include "lumigauss/util/error.h"
+#include "lumigauss/util/text.h"
+
+namespace lumigauss {
+
+TrainingRun::TrainingRun(const TrainingRunRequest& request) : paths_(run_paths(request.out)) {
+    if (request.resume) {
+        if (!std::filesystem::exists(paths_.checkpoint))
+            fail_in_file(paths_.checkpoint, "no checkpoint to resume from (start the run without --resume)");
+        TrainState state = load_checkpoint(paths_.checkpoint);
+        if (request.resume_iterations > 0) {
+            if (request.resume_iterations < state.iteration)
+                fail_in_file(paths_.checkpoint, "the run is already at iteration " +
+                                                    std::to_string(state.iteration) +
+                                                    "; --iterations must not be smaller");
+            state.config.iterations = request.resume_iterations;
+        }
+        DatasetOptions dopt;
+        dopt.downscale = state.config.downscale;
+        const Dataset data = load_dataset(request.scene, dopt);
+        sfm_points_ = data.point_xyz.size();
+        trainer_ = std::make_unique<Trainer>(load_train_views(data), std::move(state));
+        truncate_log(paths_.log, trainer_->iteration());
+        resumed_ = true;
+    } else {
+        if (std::filesystem::exists(paths_.checkpoint) && !request.force)
+            fail_in_file(paths_.checkpoint,
+                         "a run already exists here; continue it with --resume or replace it with --force");
+        DatasetOptions dopt;
+        dopt.downscale = request.config.downscale;
+        const Dataset data = load_dataset(request.scene, dopt);
+        sfm_points_ = data.point_xyz.size();
+        trainer_ =
+            std::make_unique<Trainer>(load_train_views(data), data.point_xyz, data.point_rgb, request.config);
+        std::filesystem::create_directories(request.out);  // only once the input is known to be good
+        write_file_atomically(paths_.config, train_config_to_json(request.config));
+        write_file_atomically(paths_.log, "");
+    }
+    trainer_->set_backend(request.backend);
+}
+
+TrainingRun::~TrainingRun() = default;
+
+double TrainingRun::elapsed_seconds() const {
+    return elapsed_;
+}
+
+TrainingOutcome TrainingRun::run(std::int64_t stop_after, const std::function<bool()>& stop_requested,
+                                 const std::function<void(const StepReport&)>& on_step) {
+    const TrainConfig& config = trainer_->state().config;
+    std::ofstream log(paths_.log, std::ios::app);
+    const auto t0 = std::chrono::steady_clock::now();
+    const double before = elapsed_;
+    const auto elapsed = [&] { return before + seconds_since(t0); };
+    while (!trainer_->done()) {
+        if (stop_requested() || (stop_after > 0 && trainer_->iteration() >= stop_after)) {
+            save_checkpoint(paths_.checkpoint, trainer_->state());
+            elapsed_ = elapsed();
+            return TrainingOutcome::Stopped;
+        }
+        StepReport r;
+        try {
+            r = trainer_->step();
+        } catch (const NonFiniteError& e) {
+            save_checkpoint(paths_.checkpoint, trainer_->state());
+            failure_ = e.what();
+            elapsed_ = elapsed();
+            return TrainingOutcome::NonFinite;
+        }
+        const bool log_now =
+            r.iteration % config.log_interval == 0 || r.densify_ran || r.prune_ran || trainer_->done();
+        if (log_now) log << step_log_line(r, elapsed()) << '\n' << std::flush;
+        on_step(r);
+        if (config.checkpoint_interval > 0 && r.iteration % config.checkpoint_interval == 0 &&
+            !trainer_->done())
+            save_checkpoint(paths_.checkpoint, trainer_->state());
+    }
+    save_checkpoint(paths_.checkpoint, trainer_->state());
+    save_run_model(paths_, trainer_->state());
+    write_previews((std::filesystem::path(paths_.dir) / "previews").string(), *trainer_, 4);
+    elapsed_ = elapsed();
+    return TrainingOutcome::Finished;
+}
+
+void truncate_log(const std::string& path, std::int64_t iteration) {
+    std::ifstream in(path);
+    if (!in) return;
+    std::string kept, line;
+    const std::string key = "\"iteration\":";
+    while (std::getline(in, line)) {
+        const auto pos = line.find(key);
+        if (pos == std::string::npos) continue;
+        if (std::stoll(line.substr(pos + key.size())) <= iteration) kept += line + "\n";
+    }
+    write_file_atomically(path, kept);
+}
+
+void write_previews(const std::string& dir, const Trainer& trainer, int count) {
+    const auto& views = trainer.views();
+    std::filesystem::create_directories(dir);
+    for (int v = 0; v < std::min<int>(count, int(views.size())); ++v) {
+        const TrainView& view = views[std::size_t(v)];
+        const ShCoeffs<float> env = trainer.state().lighting.env_sh(v);
+        RasterImages<float> img =
+            render_with_environment(trainer.state().model, view.camera, env, ShadingMode::Both);
+        if (trainer.state().config.sky_background) {
+            const TrainState& st = trainer.state();
+            const Sh4Coeffs<float> residual =
+                st.sky_residuals.empty() ? Sh4Coeffs<float>{} : st.sky_residuals.get(v);
+            const Image sky = sky_image(view.camera, env, st.sky_residuals.empty() ? nullptr : &residual);
+            for (int first : {kShadowedOffset, kUnshadowedOffset})
+                composite_background<float>(img, sky.pixels, first);
+        }
+        const Image shadowed = raster_channels(img, kShadowedOffset, 3);
+        const Image unshadowed = raster_channels(img, kUnshadowedOffset, 3);
+        const Image* panels[3] = {&view.rgb, &shadowed, &unshadowed};
+        const int w = view.rgb.width, h = view.rgb.height;
+        Image out(3 * w, h, 3);
+        for (int k = 0; k < 3; ++k)
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x)
+                    for (int c = 0; c < 3; ++c)
+                        out.at(k * w + x, y, c) = std::clamp(panels[k]->at(x, y, c), 0.0f, 1.0f);
+        std::filesystem::path name = std::filesystem::path(dir) / view.name;
+        name.replace_extension(".png");
+        std::filesystem::create_directories(name.parent_path());
+        write_png(name.string(), out);
+    }
+}
+
+}  // namespace lumigauss

@@ -1,0 +1,71 @@
+#pragma once
+// The life of a training run in its folder (model/run_files.h): start it (config.json, an empty log) or
+// resume it from its checkpoint (the log cut back to the checkpoint's iteration), train with a log line at
+// the config's cadence and checkpoints at its interval, stop with a checkpoint when asked to or after a given
+// iteration, and on a non-finite value keep the last good state; a finished run writes its model and
+// previews. `lumigauss train` only parses flags and prints around it.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "lumigauss/model/run_files.h"
+#include "lumigauss/render/rasterizer.h"
+#include "lumigauss/train/train_config.h"
+#include "lumigauss/train/trainer.h"
+
+namespace lumigauss {
+
+struct TrainingRunRequest {
+    std::string scene, out;
+    bool resume = false;
+    bool force = false;                  // a new run may replace a run already in `out`
+    TrainConfig config;                  // a new run's configuration (a resumed run keeps its own)
+    std::int64_t resume_iterations = 0;  // resume only: > 0 sets a new total (not below the checkpoint's)
+    RasterBackend backend = RasterBackend::Cpu;
+};
+
+enum class TrainingOutcome {
+    Finished,   // every iteration ran; model, lighting, appearance and previews written
+    Stopped,    // stopped at stop_after or when asked to; checkpoint written
+    NonFinite,  // a loss or gradient was not finite; the last good state is in the checkpoint
+};
+
+class TrainingRun {
+  public:
+    // Starts or resumes. Throws Error naming the file or the flag when the run cannot (no checkpoint to
+    // resume, a run already there without force, a smaller total than the checkpoint's, a bad dataset);
+    // then nothing in `out` has changed.
+    explicit TrainingRun(const TrainingRunRequest& request);
+    ~TrainingRun();
+
+    // Trains until the run is done, `stop_after` (> 0) is reached, or `stop_requested` returns true
+    // (checked before every iteration); `on_step` sees every iteration's report.
+    TrainingOutcome run(std::int64_t stop_after, const std::function<bool()>& stop_requested,
+                        const std::function<void(const StepReport&)>& on_step);
+
+    const Trainer& trainer() const { return *trainer_; }
+    const RunPaths& paths() const { return paths_; }
+    bool resumed() const { return resumed_; }
+    std::size_t sfm_points() const { return sfm_points_; }
+    // The message of the non-finite value that ended run() (TrainingOutcome::NonFinite).
+    const std::string& failure() const { return failure_; }
+    double elapsed_seconds() const;  // in run(), this process
+
+  private:
+    RunPaths paths_;
+    std::unique_ptr<Trainer> trainer_;
+    bool resumed_ = false;
+    std::size_t sfm_points_ = 0;
+    std::string failure_;
+    double elapsed_ = 0;
+};
+
+// Keeps the log lines up to `iteration` (a resumed run rewrites what followed its checkpoint).
+void truncate_log(const std::string& path, std::int64_t iteration);
+
+// dir/NAME.png for the first `count` training photos: the photo, the shadowed and the unshadowed render under
+// the photo's learned environment (with its sky when trained with it), side by side, clipped to [0, 1].
+void write_previews(const std::string& dir, const Trainer& trainer, int count);
+
+}  // namespace lumigauss
