@@ -72,6 +72,17 @@ TEST(Ply, ErrorsNameTheFileAndTheProblem) {
     write_text(dir / "trunc.ply",
                "ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty float x\nend_header\nabcd");
     expect_error([&] { read_ply_vertices(dir / "trunc.ply"); }, {"trunc.ply", "truncated"});
+    // A tiny file declaring a huge count fails before anything is allocated for it (it used to ask for 4 TB
+    // per column and end in std::bad_alloc, or the OOM killer for smaller counts).
+    write_text(dir / "huge.ply",
+               "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\nproperty float x\n"
+               "end_header\nabcd");
+    expect_error([&] { read_ply_vertices(dir / "huge.ply"); },
+                 {"huge.ply", "declares 1000000000000", "4 bytes"});
+    write_text(dir / "huge_ascii.ply",
+               "ply\nformat ascii 1.0\nelement vertex 20000000\nproperty float x\nproperty float "
+               "y\nend_header\n1 2\n");
+    expect_error([&] { read_ply_vertices(dir / "huge_ascii.ply"); }, {"huge_ascii.ply", "declares 20000000"});
     write_text(dir / "nan.ply",
                "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\nnan\n");
     expect_error([&] { read_ply_vertices(dir / "nan.ply"); }, {"nan.ply"});

@@ -175,6 +175,30 @@ void read_element_ascii(std::istream& in, const PlyElement& e, PlyVertexTable* t
     }
 }
 
+// The bytes of the file after its header.
+std::uint64_t bytes_after_header(std::istream& in, const std::string& path) {
+    const std::streampos here = in.tellg();
+    in.seekg(0, std::ios::end);
+    const std::streampos end = in.tellg();
+    in.seekg(here);
+    if (here < 0 || end < here || !in) fail_in_file(path, "cannot measure the PLY file");
+    return std::uint64_t(end - here);
+}
+
+// A declared record count must fit in the bytes that follow the header (a 700-byte file must not make the
+// reader allocate for 20 million vertices): binary records have a fixed size, ASCII ones take at least two
+// bytes per property (a digit and a separator).
+void check_declared_count(const PlyElement& e, PlyFormat format, std::uint64_t data_bytes,
+                          const std::string& path) {
+    std::uint64_t record = 0;
+    for (const auto& p : e.properties)
+        record += format == PlyFormat::Ascii ? 2 : std::uint64_t(type_size(p.type, path));
+    if (record == 0 || e.count <= data_bytes / record) return;
+    fail_in_file(path, "truncated, or a wrong count: declares " + std::to_string(e.count) + " '" + e.name +
+                           "' records of at least " + std::to_string(record) + " bytes, but only " +
+                           std::to_string(data_bytes) + " bytes follow the header");
+}
+
 }  // namespace
 
 bool PlyVertexTable::has(const std::string& name) const {
@@ -198,6 +222,7 @@ PlyVertexTable read_ply_vertices(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) fail_in_file(path, "cannot open PLY file");
     const PlyHeader h = parse_header(in, path);
+    const std::uint64_t data_bytes = bytes_after_header(in, path);
     const bool swap = (h.format == PlyFormat::BinaryBig) == (std::endian::native == std::endian::little);
     PlyVertexTable table;
     bool found = false;
@@ -205,6 +230,7 @@ PlyVertexTable read_ply_vertices(const std::string& path) {
         PlyVertexTable* target = nullptr;
         if (e.name == "vertex" && !found) {
             found = true;
+            check_declared_count(e, h.format, data_bytes, path);  // before allocating for it
             table.count = e.count;
             for (const auto& p : e.properties) {
                 table.names.push_back(p.name);

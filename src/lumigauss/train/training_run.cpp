@@ -20,6 +20,21 @@
 
 namespace lumigauss {
 
+namespace {
+
+// What a replaced run (--force) leaves must not outlive it: a crash before the new run's first checkpoint
+// followed by --resume would otherwise continue the old run under the new config. Only the run's own files
+// go; anything else in the folder stays.
+void remove_previous_run(const RunPaths& paths) {
+    namespace fs = std::filesystem;
+    for (const std::string* f :
+         {&paths.checkpoint, &paths.model, &paths.lighting, &paths.appearance, &paths.sky})
+        fs::remove(*f);
+    fs::remove_all(fs::path(paths.dir) / "previews");
+}
+
+}  // namespace
+
 TrainingRun::TrainingRun(const TrainingRunRequest& request) : paths_(run_paths(request.out)) {
     if (request.resume) {
         if (!std::filesystem::exists(paths_.checkpoint))
@@ -50,6 +65,7 @@ TrainingRun::TrainingRun(const TrainingRunRequest& request) : paths_(run_paths(r
         trainer_ =
             std::make_unique<Trainer>(load_train_views(data), data.point_xyz, data.point_rgb, request.config);
         std::filesystem::create_directories(request.out);  // only once the input is known to be good
+        remove_previous_run(paths_);
         write_file_atomically(paths_.config, train_config_to_json(request.config));
         write_file_atomically(paths_.log, "");
     }

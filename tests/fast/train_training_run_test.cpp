@@ -1,0 +1,74 @@
+// The training run's life in its folder (train/training_run.h): a replaced run (--force) leaves nothing of
+// the old one that --resume could pick up, and a refused start changes nothing.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "lumigauss/synth/synth.h"
+#include "lumigauss/train/checkpoint.h"
+#include "lumigauss/train/training_run.h"
+#include "lumigauss/util/error.h"
+#include "synth_test_util.h"
+
+namespace lumigauss {
+namespace {
+
+namespace fs = std::filesystem;
+using synth_test::TempDir;
+
+const std::string& tiny_scene() {
+    static TempDir dir("training_run_scene");
+    static const std::string root = [] {
+        synth::generate_synthetic_scene(synth_test::tiny_options(dir.str()));
+        return dir.str();
+    }();
+    return root;
+}
+
+TrainingRunRequest request(const std::string& out, std::int64_t iterations) {
+    TrainingRunRequest r;
+    r.scene = tiny_scene();
+    r.out = out;
+    r.config = train_preset("fast");
+    r.config.iterations = iterations;
+    return r;
+}
+
+TEST(TrainingRun, ForceRemovesThePreviousRunBeforeTheNewOneCheckpoints) {
+    TempDir tmp("training_run_force");
+    const std::string out = tmp / "run";
+    {
+        TrainingRun first(request(out, 8));
+        ASSERT_EQ(first.run(
+                      0, [] { return false; }, [](const StepReport&) {}),
+                  TrainingOutcome::Finished);
+    }
+    const RunPaths paths = run_paths(out);
+    for (const std::string* f : {&paths.checkpoint, &paths.model, &paths.lighting, &paths.appearance})
+        ASSERT_TRUE(fs::exists(*f)) << *f;
+    ASSERT_TRUE(fs::exists(fs::path(out) / "previews"));
+    fs::create_directories(fs::path(out) / "mine");  // not the run's: stays
+
+    EXPECT_THROW(TrainingRun(request(out, 20)), Error);  // no --force: refused, nothing touched
+    EXPECT_TRUE(fs::exists(paths.checkpoint));
+
+    TrainingRunRequest forced = request(out, 20);
+    forced.force = true;
+    TrainingRun second(forced);  // started, not yet run: as if it crashed before its first checkpoint
+    for (const std::string* f : {&paths.checkpoint, &paths.model, &paths.lighting, &paths.appearance})
+        EXPECT_FALSE(fs::exists(*f)) << *f << " of the replaced run is still there";
+    EXPECT_FALSE(fs::exists(fs::path(out) / "previews"));
+    EXPECT_TRUE(fs::exists(fs::path(out) / "mine"));
+    TrainingRunRequest resume = request(out, 0);
+    resume.resume = true;
+    EXPECT_THROW(TrainingRun{resume}, Error) << "--resume found a checkpoint of the replaced run";
+
+    ASSERT_EQ(second.run(
+                  0, [] { return false; }, [](const StepReport&) {}),
+              TrainingOutcome::Finished);
+    EXPECT_EQ(load_checkpoint(paths.checkpoint).iteration, 20);
+}
+
+}  // namespace
+}  // namespace lumigauss
