@@ -182,7 +182,7 @@ void register_fit_light(CLI::App& app) {
         ->required();
     cmd->add_option("--camera", o->camera,
                     "the photo's camera: an image name of --scene (exact, or without extension), or a camera "
-                    "JSON file (relight/camera_json.h layout) with one camera or one named after the photo")
+                    "JSON file (cameras/camera_json.h layout) with one camera or one named after the photo")
         ->required();
     cmd->add_option("--image", o->image,
                     "the photo (any size with the camera's aspect ratio); default with an image name: that "

@@ -137,7 +137,7 @@ TEST(EvalMetrics, SsimOfConstantImagesIsTheLuminanceTerm) {
     EXPECT_NEAR(ssim_map(t, u).at(4, 3, 0), luminance, 1e-5);
 }
 
-// Direct evaluation of skimage's formula, written independently of eval/metrics.cpp: the window's
+// Direct evaluation of skimage's formula, written independently of io/image_metrics.cpp: the window's
 // 25 values gathered from a symmetrically padded copy (numpy.pad mode "symmetric" == scipy's "reflect"),
 // two-pass sample mean / variance / covariance with the N - 1 denominator.
 double reference_ssim_at(const Image& x, const Image& y, int px, int py, int c) {

@@ -1,6 +1,6 @@
-// Camera paths of the relighting tool: orbit cameras (relight/orbit.h) look at the centre (it projects to
+// Camera paths of the relighting tool: orbit cameras (cameras/orbit.h) look at the centre (it projects to
 // the principal point) from the scene cameras' mean height and distance; camera JSON files
-// (relight/camera_json.h) round-trip exactly and bad ones fail naming the file and the entry.
+// (cameras/camera_json.h) round-trip exactly and bad ones fail naming the file and the entry.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 

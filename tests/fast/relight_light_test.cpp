@@ -1,5 +1,5 @@
 // What `render RUN --light L` turns L into (relight/light_source.h) and how the environment is turned
-// (relight/up_axis.h): a training photo gives exactly lighting.env_sh(i), an SH file its 9 rows, a
+// (cameras/up_axis.h): a training photo gives exactly lighting.env_sh(i), an SH file its 9 rows, a
 // panorama its projection (with the official fake HDR boost for LDR files only); 360 deg is no turn and
 // 90 deg is sh_rotation's turn about the up axis.
 #include <gmock/gmock.h>

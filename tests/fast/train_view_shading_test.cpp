@@ -1,7 +1,8 @@
-// Shading of a whole GaussianModel for one camera (train/view_shading.h): the camera-facing normal rule of
-// the official compute_normal_world_space (research/lumigauss_official.md 2.1), colours equal to the
-// single-surfel functions of shading/surfel_shading.h in every mode, and the backward into the raw albedo,
-// raw quaternion, channel 0 of the transfer sets and the environment, by central finite differences.
+// Shading of a whole surfel model for one camera (model/view_shading.h, its backward
+// train/view_shading_backward.h): the camera-facing normal rule of the official compute_normal_world_space
+// (research/lumigauss_official.md 2.1), colours equal to the single-surfel functions of
+// shading/surfel_shading.h in every mode, and the backward into the raw albedo, raw quaternion, channel 0 of
+// the transfer sets and the environment, by central finite differences.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 

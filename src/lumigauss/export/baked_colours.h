@@ -1,7 +1,7 @@
 #pragma once
 // One colour per surfel under one environment, for the formats that hold a single colour per splat
 // (ply-3dgs, splat). LumiGauss shading is view-dependent only through the two-sided surfel: the side facing
-// the camera picks the normal (unshadowed) or the transfer set (shadowed) (train/view_shading.h). A
+// the camera picks the normal (unshadowed) or the transfer set (shadowed) (model/view_shading.h). A
 // one-colour splat cannot switch sides, so the bake always shades the POSITIVE side: the unit normal
 // +R(q)[:,2] and the positive transfer set, i.e. exactly what render_with_environment gives for a camera
 // that sees the surfel's +normal side. Surfels seen from their back side get the front side's colour.

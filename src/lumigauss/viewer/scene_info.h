@@ -5,13 +5,13 @@
 //    "up": [0, 0, 1], "up_name": "+z", "e1": [1, 0, 0], "e2": [0, 1, 0],
 //    "centre": [x, y, z], "radius": r,
 //    "camera": null | {"width": W, "height": H, "fx": .., "fy": .., "cx": .., "cy": ..,
-//                      "R": [[..], [..], [..]], "t": [..]},          (relight/camera_json.h conventions)
+//                      "R": [[..], [..], [..]], "t": [..]},          (cameras/camera_json.h conventions)
 //    "lights": [{"name": "IMG_0001.jpg", "kind": "training photo", "sh": [[R, G, B] x 9]}, ...],
 //    "initial_light": 0}
 // Lights in order: those given with --light, then every training photo's learned lighting (embedding
 // order), then "uniform" (constant radiance with irradiance 1 everywhere, for inspecting albedo and
 // geometry). SH are radiance L_lm in the world frame (shading/sh.h order). up, e1, e2 form the right-handed
-// orbit frame of relight/orbit.h (azimuth a = cos a e1 + sin a e2). centre is the per-axis median of the
+// orbit frame of cameras/orbit.h (azimuth a = cos a e1 + sin a e2). centre is the per-axis median of the
 // surfel positions, radius the 90th percentile of their distance to it (robust to stray surfels).
 #include <optional>
 #include <string>
