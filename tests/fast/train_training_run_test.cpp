@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "lumigauss/synth/synth.h"
@@ -68,6 +69,21 @@ TEST(TrainingRun, ForceRemovesThePreviousRunBeforeTheNewOneCheckpoints) {
                   0, [] { return false; }, [](const StepReport&) {}),
               TrainingOutcome::Finished);
     EXPECT_EQ(load_checkpoint(paths.checkpoint).iteration, 20);
+}
+
+// A damaged log line must not block --resume (it stopped it with "internal error: stoll" before): the
+// checkpoint is the state; the log keeps its readable lines up to the checkpoint.
+TEST(TrainingRun, ResumeCutsTheLogAndDropsDamagedLines) {
+    TempDir tmp("training_run_log");
+    const std::string log = tmp / "log.jsonl";
+    std::ofstream(log)
+        << ("{\"iteration\":5,\"total\":1}\n"
+            "{\"iteration\":garbage}\n"
+            "{\"iteration\":10,\"tot\n"
+            "{\"iteration\":15,\"total\":1}\n"
+            "not json at all\n");
+    truncate_log(log, 10);
+    EXPECT_EQ(synth_test::read_bytes(log), "{\"iteration\":5,\"total\":1}\n");
 }
 
 }  // namespace

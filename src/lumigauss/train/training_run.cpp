@@ -4,6 +4,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/io/dataset.h"
@@ -119,11 +120,13 @@ void truncate_log(const std::string& path, std::int64_t iteration) {
     std::ifstream in(path);
     if (!in) return;
     std::string kept, line;
-    const std::string key = "\"iteration\":";
     while (std::getline(in, line)) {
-        const auto pos = line.find(key);
-        if (pos == std::string::npos) continue;
-        if (std::stoll(line.substr(pos + key.size())) <= iteration) kept += line + "\n";
+        // A damaged line (a crash mid-write, an edit) is dropped: the checkpoint, not the log, is the state,
+        // so it must not stop the run from resuming.
+        const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+        if (j.is_object() && j.contains("iteration") && j["iteration"].is_number_integer() &&
+            j["iteration"].get<std::int64_t>() <= iteration)
+            kept += line + "\n";
     }
     write_file_atomically(path, kept);
 }

@@ -61,7 +61,8 @@ class TrainingRun {
     double elapsed_ = 0;
 };
 
-// Keeps the log lines up to `iteration` (a resumed run rewrites what followed its checkpoint).
+// Keeps the log lines up to `iteration` (a resumed run rewrites what followed its checkpoint); lines that are
+// not a JSON object with an integer "iteration" are dropped.
 void truncate_log(const std::string& path, std::int64_t iteration);
 
 // dir/NAME.png for the first `count` training photos: the photo, the shadowed and the unshadowed render under
