@@ -18,13 +18,12 @@ void MultiLightRenderer::shade_pass(std::span<const ShCoeffs<float>> envs, const
     const std::size_t n = model_.size(), ch = 3 * envs.size();
     batch.channels = int(ch);
     batch.colors.resize(n * ch);
-    const auto& albedo = model_.param(ModelParam::Albedo);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
         float pos[kTransferCoeffs], neg[kTransferCoeffs];
         for (std::size_t i = r.begin(); i < r.end(); ++i) {
             model_.transfer_channel0(true, i, pos);
             model_.transfer_channel0(false, i, neg);
-            const Vec3f raw{albedo[3 * i], albedo[3 * i + 1], albedo[3 * i + 2]};
+            const Vec3f raw = model_.raw_albedo(i);
             const bool positive = normals.positive_side[i] != 0;
             for (std::size_t k = 0; k < envs.size(); ++k) {
                 const Vec3f rgb = surfel_colour_shadowed(envs[k], raw, pos, neg, positive);
@@ -41,9 +40,12 @@ std::vector<Image> MultiLightRenderer::render_shadowed(const Camera& camera,
     for (std::size_t first = 0; first < envs.size(); first += kLightsPerPass) {
         const std::span<const ShCoeffs<float>> pass =
             envs.subspan(first, std::min<std::size_t>(kLightsPerPass, envs.size() - first));
-        const RasterImages<float>& images = renderer_.render(
-            model_, camera,
-            [&](const ViewNormals& normals, SurfelBatch<float>& batch) { shade_pass(pass, normals, batch); });
+        const SurfelShader shade = [&](const ViewNormals& normals, SurfelBatch<float>& batch) {
+            shade_pass(pass, normals, batch);
+        };
+        // The view's normals and geometry once; the later passes only re-shade and rasterize.
+        const RasterImages<float>& images =
+            first == 0 ? renderer_.render(model_, camera, shade) : renderer_.recolour(camera, shade);
         for (std::size_t k = 0; k < pass.size(); ++k) out.push_back(raster_channels(images, int(3 * k), 3));
     }
     return out;

@@ -14,6 +14,13 @@ const RasterImages<float>& ModelRenderer::render(const SurfelModel& model, const
     return images_;
 }
 
+const RasterImages<float>& ModelRenderer::recolour(const Camera& camera, const SurfelShader& shade,
+                                                   const RasterSettings<float>& settings) {
+    shade(normals_, batch_);
+    rasterizer_->forward(camera, batch_, settings, images_);
+    return images_;
+}
+
 const RasterImages<float>& ModelRenderer::render(const SurfelModel& model, const Camera& camera,
                                                  const ShCoeffs<float>& env, ShadingMode mode,
                                                  const RasterSettings<float>& settings) {

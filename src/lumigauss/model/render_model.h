@@ -31,6 +31,11 @@ class ModelRenderer {
                                       const ShCoeffs<float>& env, ShadingMode mode,
                                       const RasterSettings<float>& settings = {});
 
+    // The last render's model and camera again with other colours: its normals and geometry are reused,
+    // only the shading and the rasterisation run (several lights per view). `model` must be unchanged since.
+    const RasterImages<float>& recolour(const Camera& camera, const SurfelShader& shade,
+                                        const RasterSettings<float>& settings = {});
+
     // What the last render computed: the view's normals and sides, the surfels as rasterized.
     const ViewNormals& normals() const { return normals_; }
     const SurfelBatch<float>& batch() const { return batch_; }
