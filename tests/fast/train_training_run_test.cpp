@@ -6,6 +6,7 @@
 #include <fstream>
 #include <string>
 
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/synth/synth.h"
 #include "lumigauss/train/checkpoint.h"
 #include "lumigauss/train/training_run.h"
@@ -69,6 +70,24 @@ TEST(TrainingRun, ForceRemovesThePreviousRunBeforeTheNewOneCheckpoints) {
                   0, [] { return false; }, [](const StepReport&) {}),
               TrainingOutcome::Finished);
     EXPECT_EQ(load_checkpoint(paths.checkpoint).iteration, 20);
+}
+
+// A stopped run (--stop-after, Ctrl-C) could be resumed but not looked at: model.ply appeared only at the
+// end. The snapshot written with the checkpoint opens as a run and holds the checkpoint's surfels.
+TEST(TrainingRun, AStoppedRunCanBeOpened) {
+    TempDir tmp("training_run_snapshot");
+    const std::string out = tmp / "run";
+    TrainingRun run(request(out, 20));
+    ASSERT_EQ(run.run(
+                  7, [] { return false; }, [](const StepReport&) {}),
+              TrainingOutcome::Stopped);
+    const TrainState checkpoint = load_checkpoint(run_paths(out).checkpoint);
+    ASSERT_EQ(checkpoint.iteration, 7);
+    const TrainedRun opened = load_trained_run(out);
+    ASSERT_EQ(opened.model.size(), checkpoint.model.size());
+    for (const ModelParam p : kAllModelParams)
+        EXPECT_EQ(opened.model.param(p), checkpoint.model.param(p)) << "parameter " << int(p);
+    EXPECT_EQ(opened.image_names, checkpoint.image_names);
 }
 
 // A damaged log line must not block --resume (it stopped it with "internal error: stoll" before): the

@@ -75,6 +75,13 @@ TrainingRun::TrainingRun(const TrainingRunRequest& request) : paths_(run_paths(r
 
 TrainingRun::~TrainingRun() = default;
 
+// The checkpoint resumes the run; the model files beside it let render, eval, export and view open a run
+// that is still training, was stopped or was interrupted (each file is replaced atomically).
+void TrainingRun::save_checkpoint_and_snapshot() {
+    save_checkpoint(paths_.checkpoint, trainer_->state());
+    save_run_model(paths_, trainer_->state());
+}
+
 double TrainingRun::elapsed_seconds() const {
     return elapsed_;
 }
@@ -88,7 +95,7 @@ TrainingOutcome TrainingRun::run(std::int64_t stop_after, const std::function<bo
     const auto elapsed = [&] { return before + seconds_since(t0); };
     while (!trainer_->done()) {
         if (stop_requested() || (stop_after > 0 && trainer_->iteration() >= stop_after)) {
-            save_checkpoint(paths_.checkpoint, trainer_->state());
+            save_checkpoint_and_snapshot();
             elapsed_ = elapsed();
             return TrainingOutcome::Stopped;
         }
@@ -107,7 +114,7 @@ TrainingOutcome TrainingRun::run(std::int64_t stop_after, const std::function<bo
         on_step(r);
         if (config.checkpoint_interval > 0 && r.iteration % config.checkpoint_interval == 0 &&
             !trainer_->done())
-            save_checkpoint(paths_.checkpoint, trainer_->state());
+            save_checkpoint_and_snapshot();
     }
     save_checkpoint(paths_.checkpoint, trainer_->state());
     save_run_model(paths_, trainer_->state());

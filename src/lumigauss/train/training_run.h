@@ -2,8 +2,9 @@
 // The life of a training run in its folder (model/run_files.h): start it (config.json, an empty log) or
 // resume it from its checkpoint (the log cut back to the checkpoint's iteration), train with a log line at
 // the config's cadence and checkpoints at its interval, stop with a checkpoint when asked to or after a given
-// iteration, and on a non-finite value keep the last good state; a finished run writes its model and
-// previews. `lumigauss train` only parses flags and prints around it.
+// iteration, and on a non-finite value keep the last good state. Every checkpoint also writes the model
+// files (a snapshot that render, eval, export and view open); a finished run adds its previews. `lumigauss
+// train` only parses flags and prints around it.
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -27,7 +28,7 @@ struct TrainingRunRequest {
 
 enum class TrainingOutcome {
     Finished,   // every iteration ran; model, lighting, appearance and previews written
-    Stopped,    // stopped at stop_after or when asked to; checkpoint written
+    Stopped,    // stopped at stop_after or when asked to; checkpoint and model snapshot written
     NonFinite,  // a loss or gradient was not finite; the last good state is in the checkpoint
 };
 
@@ -53,6 +54,8 @@ class TrainingRun {
     double elapsed_seconds() const;  // in run(), this process
 
   private:
+    void save_checkpoint_and_snapshot();
+
     RunPaths paths_;
     std::unique_ptr<Trainer> trainer_;
     bool resumed_ = false;
