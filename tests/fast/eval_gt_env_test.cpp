@@ -256,6 +256,27 @@ TEST(EvalGtEnv, AWrongLightScaleScoresWorse) {
     EXPECT_GT(good.mean_unshadowed.psnr, worse.mean_unshadowed.psnr + 3.0);
 }
 
+// The empty-pixel diagnostic: the true surfels cover the evaluated pixels (the mask is gt/mask eroded, so
+// none of them is an edge), and the same surfels faded to nothing leave every one empty, with no covered
+// PSNR.
+TEST(EvalGtEnv, EmptyPixelsAreCountedOverTheEvaluationMask) {
+    const std::string& root = tiny_scene();
+    const Dataset scene = load_dataset(root);
+    const GtSceneMeta meta = load_gt_scene_meta(root);
+    GtEnvOptions opt;
+    opt.keep_panels = false;
+    const GtEnvResult full = evaluate_gt_env(oracle_run(root, 1.0), scene, meta, opt);
+    EXPECT_LT(full.empty_fraction, 0.01);
+    EXPECT_NEAR(full.mean_covered_shadowed_psnr, full.mean_shadowed.psnr, 0.5);
+    RelightableRun faded = oracle_run(root, 1.0);
+    for (float& logit : faded.model.param(ModelParam::Opacity)) logit = -20.0f;
+    const GtEnvResult none = evaluate_gt_env(faded, scene, meta, opt);
+    EXPECT_EQ(none.empty_fraction, 1.0);
+    EXPECT_TRUE(std::isnan(none.mean_covered_shadowed_psnr));
+    for (const GtEnvImageResult& im : none.images) EXPECT_EQ(im.empty_fraction, 1.0) << im.name;
+    EXPECT_TRUE(gt_env_metrics_json(none, {"run", root})["mean"].contains("empty"));
+}
+
 TEST(EvalGtEnv, WorksWithoutGroundTruthImages) {
     // Only meta.json and env/*_sh.txt are required: without gt/ the mask is the scene's own (eroded), and
     // albedo and normal metrics are left out.

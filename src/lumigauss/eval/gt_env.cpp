@@ -323,6 +323,14 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
         }
         r.shadowed = image_metrics(p.shadowed, p.truth, p.mask, options.ssim);
         r.unshadowed = image_metrics(p.unshadowed, p.truth, p.mask, options.ssim);
+        Image covered_mask = p.mask;
+        for (std::size_t q = 0; q < covered_mask.pixels.size(); ++q)
+            if (relit.alpha[q] <= 0.5f) covered_mask.pixels[q] = 0.0f;
+        const std::size_t covered_pixels = mask_pixels(covered_mask);
+        r.empty_fraction = 1.0 - double(covered_pixels) / double(r.mask_pixels);
+        r.covered_shadowed_psnr = covered_pixels > 0
+                                      ? psnr_from_mse(masked_mse(p.shadowed, p.truth, covered_mask))
+                                      : std::numeric_limits<double>::quiet_NaN();
 
         // The paper's shadow image (as `render` writes it) and the model's albedo and normal maps.
         p.shadow = shadow_image(raster_channels(relit, kRelitIntensityUnshadowed, 3),
@@ -432,6 +440,17 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
     double sky_covered = 0;
     for (const GtEnvImageResult& r : result.images)
         sky_pixels += r.sky_pixels, sky_covered += r.sky_alpha_fraction * double(r.sky_pixels);
+    std::size_t evaluated = 0, covered_images = 0;
+    double empty = 0;
+    for (const GtEnvImageResult& r : result.images) {
+        evaluated += r.mask_pixels, empty += r.empty_fraction * double(r.mask_pixels);
+        if (!std::isnan(r.covered_shadowed_psnr))
+            result.mean_covered_shadowed_psnr += r.covered_shadowed_psnr, ++covered_images;
+    }
+    result.empty_fraction = evaluated > 0 ? empty / double(evaluated) : 0.0;
+    result.mean_covered_shadowed_psnr = covered_images > 0
+                                            ? result.mean_covered_shadowed_psnr / double(covered_images)
+                                            : std::numeric_limits<double>::quiet_NaN();
     result.has_sky = sky_pixels > 0;
     result.sky_alpha_fraction = result.has_sky ? sky_covered / double(sky_pixels) : 0.0;
     std::vector<double> render_ms;

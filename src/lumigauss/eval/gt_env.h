@@ -29,8 +29,12 @@
 // 5. Sky (when gt/mask exists): the share of the pixels that see no geometry (gt/mask = 0) where the
 //    render's alpha exceeds 0.5. A run trained with the sky background (config.json "sky_background") is
 //    rendered as it was trained, the sky of the evaluation light drawn behind its surfels (the metrics'
-//    mask excludes the sky, so this changes only edge pixels and the contact sheets).
-// 6. Normals (when gt/normal exists): the rasterised world normal map, normalised, against gt/normal decoded
+//    mask excludes the sky, so this changes the pixels the model leaves empty or partly transparent, and the
+//    contact sheets).
+// 6. Empty pixels: the share of the evaluated pixels where the render's alpha is at most 0.5 (the model has
+//    no surface there, e.g. ground that no training photo sees closely), and the shadowed PSNR over the
+//    rest. A diagnostic beside the metrics of 3, which score every evaluated pixel.
+// 7. Normals (when gt/normal exists): the rasterised world normal map, normalised, against gt/normal decoded
 //    as 2v - 1 and normalised; angles in degrees over the evaluation mask; a pixel with no rendered normal
 //    counts as 90 deg. Per image mean and median; overall the mean of those and the pooled statistics.
 // Ground-truth images are area-resampled to the evaluated resolution (-r) like the photos.
@@ -143,6 +147,11 @@ struct GtEnvImageResult {
     // painting the sky seen from a new viewpoint. 0 pixels when the scene has no gt/mask.
     std::size_t sky_pixels = 0;
     double sky_alpha_fraction = 0;
+    // Evaluated pixels the model leaves empty (alpha <= 0.5): geometry no training photo pinned down, drawn
+    // as background. The shadowed PSNR over the other evaluated pixels separates that from the shading error
+    // (NaN when the model covers none of them).
+    double empty_fraction = 0;
+    double covered_shadowed_psnr = 0;
     ImageMetrics shadowed, unshadowed;
     bool has_albedo = false, has_normal = false;
     AlbedoMetrics albedo, albedo_gamma;
@@ -160,8 +169,10 @@ struct GtEnvResult {
     // Means over images (PSNR averaged as PSNR, as officially).
     ImageMetrics mean_shadowed, mean_unshadowed;
     double median_render_ms = 0;
-    bool has_sky = false;           // some scored image had sky pixels
-    double sky_alpha_fraction = 0;  // over every sky pixel of every scored image
+    bool has_sky = false;                   // some scored image had sky pixels
+    double sky_alpha_fraction = 0;          // over every sky pixel of every scored image
+    double empty_fraction = 0;              // over every evaluated pixel of every scored image
+    double mean_covered_shadowed_psnr = 0;  // mean over the images that have covered pixels
     std::array<double, 3> albedo_scale{1, 1, 1}, albedo_gamma_scale{1, 1, 1};
     AlbedoMetrics mean_albedo, mean_albedo_gamma;
     AngularErrorStats mean_normal;    // mean of the per-image means and of the per-image medians

@@ -197,6 +197,8 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
         if (im.has_normal) e["normal"] = normal_json(im.normal);
         if (im.sky_pixels > 0)
             e["sky"] = {{"pixels", im.sky_pixels}, {"alpha_above_half", number(im.sky_alpha_fraction)}};
+        e["empty"] = {{"fraction", number(im.empty_fraction)},
+                      {"shadowed_psnr_covered", number(im.covered_shadowed_psnr)}};
         images.push_back(std::move(e));
     }
     j["images"] = images;
@@ -211,6 +213,12 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
             {"value", number(r.sky_alpha_fraction)},
             {"meaning",
              "share of all sky pixels (gt/mask = 0) of the scored images where the render's alpha > 0.5"}};
+    mean["empty"] = {
+        {"fraction", number(r.empty_fraction)},
+        {"shadowed_psnr_covered", number(r.mean_covered_shadowed_psnr)},
+        {"meaning",
+         "share of all evaluated pixels where the render's alpha <= 0.5 (no surface), and the mean "
+         "shadowed PSNR over the other evaluated pixels"}};
     j["mean"] = mean;
     j["median_render_ms"] = r.median_render_ms;
     if (r.has_normal) j["normal_all_pixels"] = normal_json(r.pooled_normal);
@@ -274,6 +282,8 @@ std::string gt_env_report_markdown(const GtEnvResult& r, const ReportSources& sr
              " deg (means of the per-image values); over all pixels: mean " +
              fmt("%.2f", r.pooled_normal.mean_deg) + ", median " + fmt("%.2f", r.pooled_normal.median_deg) +
              " deg.\n";
+    s += "\nEvaluated pixels the model leaves empty (alpha <= 0.5): " + fmt("%.2f", 100 * r.empty_fraction) +
+         " %; shadowed PSNR over the covered ones " + fmt("%.2f", r.mean_covered_shadowed_psnr) + " dB.\n";
     if (r.has_sky)
         s += "\nSky pixels (`gt/mask` = 0) covered by surfels (alpha > 0.5): " +
              fmt("%.2f", 100 * r.sky_alpha_fraction) + " %.\n";
