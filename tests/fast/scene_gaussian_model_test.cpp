@@ -292,11 +292,17 @@ TEST(SceneModelDensify, ScreenAndWorldSizePrune) {
 TEST(SceneModelOpacity, ResetCapsAndClearsMoments) {
     GaussianModel m = constructed_case();
     const auto before = m.param(ModelParam::Opacity);
-    m.reset_opacity();
+    m.reset_opacity(0.01f);
     for (std::size_t i = 0; i < m.size(); ++i) {
         const float o = 1.0f / (1.0f + std::exp(-m.param(ModelParam::Opacity)[i]));
         const float o0 = 1.0f / (1.0f + std::exp(-before[i]));
         EXPECT_NEAR(o, std::min(o0, 0.01f), 1e-6f);
+    }
+    GaussianModel higher = constructed_case();
+    higher.reset_opacity(0.1f);
+    for (std::size_t i = 0; i < higher.size(); ++i) {
+        const float o = 1.0f / (1.0f + std::exp(-higher.param(ModelParam::Opacity)[i]));
+        EXPECT_NEAR(o, std::min(1.0f / (1.0f + std::exp(-before[i])), 0.1f), 1e-6f);
     }
     for (float v : m.adam(ModelParam::Opacity).exp_avg()) EXPECT_EQ(v, 0.0f);
     for (float v : m.adam(ModelParam::Opacity).exp_avg_sq()) EXPECT_EQ(v, 0.0f);

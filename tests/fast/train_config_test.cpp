@@ -111,6 +111,7 @@ std::vector<MemberChange> every_member() {
         {"opacity_reset_interval", [](TrainConfig& c) { c.opacity_reset_interval = 600; }},
         {"densify_grad_threshold", [](TrainConfig& c) { c.densify_grad_threshold = 0.00021; }},
         {"min_opacity", [](TrainConfig& c) { c.min_opacity = 0.005; }},
+        {"opacity_reset_value", [](TrainConfig& c) { c.opacity_reset_value = 0.2; }},
         {"max_screen_size", [](TrainConfig& c) { c.max_screen_size = 0.0; }},
         {"percent_dense", [](TrainConfig& c) { c.percent_dense = 0.015; }},
         {"faithful_radii_reset", [](TrainConfig& c) { c.faithful_radii_reset = false; }},
@@ -181,6 +182,7 @@ TEST(TrainConfigPreset, PaperHasTheOfficialValues) {
     EXPECT_EQ(c.opacity_reset_interval, 3000);
     EXPECT_EQ(c.densify_grad_threshold, 0.0002);
     EXPECT_EQ(c.min_opacity, 0.05);
+    EXPECT_EQ(c.opacity_reset_value, 0.01);
     EXPECT_EQ(c.max_screen_size, 20.0);
     EXPECT_EQ(c.percent_dense, 0.01);
     EXPECT_TRUE(c.faithful_radii_reset);
@@ -269,7 +271,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 59, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 60, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;
@@ -617,6 +619,8 @@ TEST(TrainConfigValidate, RejectsEachBadValueNamingTheKey) {
         {"densify_grad_threshold", [](TrainConfig& c) { c.densify_grad_threshold = -1e-4; }},
         {"min_opacity", [](TrainConfig& c) { c.min_opacity = -0.01; }},
         {"min_opacity", [](TrainConfig& c) { c.min_opacity = 1.0; }},
+        {"opacity_reset_value", [](TrainConfig& c) { c.opacity_reset_value = 0.0; }},
+        {"opacity_reset_value", [](TrainConfig& c) { c.opacity_reset_value = 1.0; }},
         {"max_screen_size", [](TrainConfig& c) { c.max_screen_size = -1; }},
         {"percent_dense", [](TrainConfig& c) { c.percent_dense = 0.0; }},
         {"checkpoint_interval", [](TrainConfig& c) { c.checkpoint_interval = -1; }},

@@ -302,9 +302,9 @@ std::size_t GaussianModel::prune(double min_opacity, double max_world_scale) {
     return removed;
 }
 
-void GaussianModel::reset_opacity() {
+void GaussianModel::reset_opacity(float ceiling) {
     auto& o = param(ModelParam::Opacity);
-    for (float& v : o) v = inverse_sigmoid(std::min(sigmoid(v), 0.01f));
+    for (float& v : o) v = inverse_sigmoid(std::min(sigmoid(v), ceiling));
     adam(ModelParam::Opacity).reset_moments();
 }
 

@@ -105,8 +105,9 @@ class GaussianModel : public SurfelModel {
     // The prune alone, for the iterations after densification: removes surfels with opacity < min_opacity or
     // (max_world_scale > 0) a scale above max_world_scale. Returns how many were removed.
     std::size_t prune(double min_opacity, double max_world_scale);
-    // opacity <- min(opacity, 0.01) (as logit), opacity moments zeroed (replace_tensor_to_optimizer).
-    void reset_opacity();
+    // opacity <- min(opacity, ceiling) (as logit; officially 0.01), opacity moments zeroed
+    // (replace_tensor_to_optimizer).
+    void reset_opacity(float ceiling);
     // Keeps rows with keep[i] != 0 in every parameter, gradient, Adam state and statistic.
     void keep_rows(std::span<const std::uint8_t> keep);
 

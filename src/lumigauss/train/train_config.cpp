@@ -77,6 +77,7 @@ constexpr std::array kFields = {
     LUMIGAUSS_FIELD(densify_until),
     LUMIGAUSS_FIELD(densify_interval),
     LUMIGAUSS_FIELD(opacity_reset_interval),
+    LUMIGAUSS_FIELD(opacity_reset_value),
     LUMIGAUSS_FIELD(densify_grad_threshold),
     LUMIGAUSS_FIELD(min_opacity),
     LUMIGAUSS_FIELD(max_screen_size),
@@ -526,6 +527,8 @@ void validate_train_config(const TrainConfig& c) {
     require(c.densify_grad_threshold >= 0.0, "densify_grad_threshold", c.densify_grad_threshold,
             "must be >= 0");
     require(c.min_opacity >= 0.0 && c.min_opacity < 1.0, "min_opacity", c.min_opacity, "must be in [0, 1)");
+    require(c.opacity_reset_value > 0.0 && c.opacity_reset_value < 1.0, "opacity_reset_value",
+            c.opacity_reset_value, "must be in (0, 1)");
     require(c.max_screen_size >= 0.0, "max_screen_size", c.max_screen_size, "must be >= 0");
     require(c.percent_dense > 0.0, "percent_dense", c.percent_dense, "must be > 0");
 

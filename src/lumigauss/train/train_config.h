@@ -62,6 +62,11 @@ struct TrainConfig {
     std::int64_t opacity_reset_interval = 3000;
     double densify_grad_threshold = 0.0002;
     double min_opacity = 0.05;
+    // A reset sets every opacity to at most this. The official 0.01 is below min_opacity: a surfel that fewer
+    // than about a third of the photos see cannot climb back over min_opacity before the next prune (Adam moves
+    // the logit about lr_opacity per visit), so the reset itself deletes weakly observed surfaces. Above
+    // min_opacity (3DGS's ratio: reset 0.01, prune 0.005) only surfels that the photos push down are pruned.
+    double opacity_reset_value = 0.01;
     double max_screen_size = 20.0;  // pixels; applied after the first opacity reset
     double percent_dense = 0.01;
     bool faithful_radii_reset = true;  // replicate the official zeroing of max_radii2D before the prune

@@ -569,7 +569,7 @@ void Trainer::densify_step(std::int64_t it, Stage stage, StepReport& report) {
         model.zero_grad();
     }
     if (it % c.opacity_reset_interval == 0) {
-        model.reset_opacity();
+        model.reset_opacity(float(c.opacity_reset_value));
         model.drop_grad(ModelParam::Opacity);
         report.opacity_reset = true;
     }
