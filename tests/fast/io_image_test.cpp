@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "fast/io_test_util.h"
@@ -152,6 +153,57 @@ TEST(IoImage, ErrorsNameTheFile) {
     expect_error([&] { read_image(tmp / "cut.exr"); }, {"cut.exr"});
     expect_error([&] { write_png(tmp / "no_such_dir/x.png", test::test_image(2, 2, 3)); }, {"x.png"});
     expect_error([&] { write_png(tmp / "x.png", test::test_image(2, 2, 3), 12); }, {"x.png", "8 or 16"});
+}
+
+// stb_image decodes a cut Radiance file as if its missing scanlines were black, and `env` then projected
+// a black sky without a word. Both scanline layouts: run-length encoded (width >= 8) and flat.
+TEST(IoImage, CutRadianceHdrIsRefused) {
+    TempDir tmp;
+    for (const int width : {64, 4}) {
+        Image radiance(width, 32, 3);
+        for (std::size_t i = 0; i < radiance.pixels.size(); ++i) radiance.pixels[i] = 0.5f + float(i % 7);
+        const std::string full = tmp / "full.hdr";
+        ASSERT_TRUE(stbi_write_hdr(full.c_str(), width, 32, 3, radiance.pixels.data()));
+        EXPECT_EQ(read_image(full).width, width);
+        const std::string bytes = test::read_text(full);
+        const std::size_t header = bytes.find("+X");
+        ASSERT_NE(header, std::string::npos);
+        for (const std::size_t keep : {header + 8, bytes.size() / 2, bytes.size() - 1}) {
+            test::write_text(tmp / "cut.hdr", bytes.substr(0, keep));
+            expect_error([&] { read_image(tmp / "cut.hdr"); }, {"cut.hdr", "truncated"});
+        }
+    }
+    test::write_text(tmp / "headless.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n");
+    expect_error([&] { read_image(tmp / "headless.hdr"); }, {"headless.hdr"});
+}
+
+// A 379 KB PNG declaring 20000 x 20000 pixels took 1.9 GB before failing without naming the file. The
+// declared size is now checked against kMaxImagePixels before anything is decoded.
+TEST(IoImage, DeclaredSizeOverTheLimitIsRefused) {
+    TempDir tmp;
+    const auto big_endian = [](std::uint32_t v) {
+        return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+    };
+    const auto crc32 = [](const std::string& data) {
+        std::uint32_t c = 0xffffffffu;
+        for (const unsigned char byte : data) {
+            c ^= byte;
+            for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+        }
+        return ~c;
+    };
+    const auto png_declaring = [&](std::uint32_t width, std::uint32_t height) {
+        const std::string ihdr = "IHDR" + big_endian(width) + big_endian(height) + std::string{8, 2, 0, 0, 0};
+        return std::string("\x89PNG\r\n\x1a\n", 8) + big_endian(13) + ihdr + big_endian(crc32(ihdr));
+    };
+    // Under stb's own 1 GiB bound: the header reads, the pixels are refused.
+    test::write_text(tmp / "large.png", png_declaring(15000, 15000));
+    EXPECT_EQ(read_image_info(tmp / "large.png").width, 15000);
+    expect_error([&] { read_image(tmp / "large.png"); }, {"large.png", "15000 x 15000", "limit"});
+    // Over it (stb says "unknown image type"): the declared size is still what the message names.
+    test::write_text(tmp / "huge.png", png_declaring(20000, 20000));
+    expect_error([&] { read_image_info(tmp / "huge.png"); }, {"huge.png", "20000 x 20000", "limit"});
+    expect_error([&] { read_image(tmp / "huge.png"); }, {"huge.png", "20000 x 20000", "limit"});
 }
 
 TEST(IoImage, ResizeAreaAveragesBlocksExactly) {

@@ -27,13 +27,18 @@ struct ImageInfo {
     int width = 0, height = 0, channels = 0;
 };
 
+// The largest image any reader accepts: 16384 x 8192 (a 16K panorama), 134 megapixels, 2 GiB as RGBA floats.
+// A file that declares more is refused before its pixels are allocated.
+inline constexpr long long kMaxImagePixels = 16384LL * 8192LL;
+
 // Size and channel count from the header (PNG, JPEG, HDR, EXR, and what else stb_image reads).
 // Throws Error naming the file if it is missing or not a readable image.
 ImageInfo read_image_info(const std::string& path);
 
 // PNG (8/16 bit), JPEG, Radiance .hdr, OpenEXR. Gray stays 1 channel, gray+alpha 2, RGB 3, RGBA 4; an EXR
 // gives 1 channel if it has one, 4 if it has an alpha channel, else 3 (R, G, B).
-// Throws Error naming the file if it is missing, corrupt or of an unsupported format.
+// Throws Error naming the file if it is missing, corrupt, cut short (Radiance .hdr), larger than
+// kMaxImagePixels or of an unsupported format.
 Image read_image(const std::string& path);
 
 // 8 or 16 bit PNG with the image's channel count (1 to 4). Values are clamped to [0, 1] (NaN -> 0) and

@@ -2,14 +2,19 @@
 #include <stb/stb_image.h>
 #include <tinyexr.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
 
 #include "lumigauss/io/image.h"
+#include "lumigauss/io/radiance_scanlines.h"
+#include "lumigauss/io/text_file.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {
@@ -90,22 +95,73 @@ Image decode_with_stb(const std::string& path, Load load, float max_code) {
     return image;
 }
 
+// Width and height from a PNG's IHDR chunk (signature, length, "IHDR", two big-endian 32-bit numbers).
+std::optional<ImageInfo> png_header_size(const std::string& path) {
+    unsigned char head[24] = {};
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) return std::nullopt;
+    const std::size_t n = std::fread(head, 1, sizeof head, f);
+    std::fclose(f);
+    if (n != sizeof head || std::memcmp(head, "\x89PNG\r\n\x1a\n", 8) != 0 ||
+        std::memcmp(head + 12, "IHDR", 4) != 0)
+        return std::nullopt;
+    const auto big_endian = [&](int at) {
+        return (std::uint32_t(head[at]) << 24) | (std::uint32_t(head[at + 1]) << 16) |
+               (std::uint32_t(head[at + 2]) << 8) | std::uint32_t(head[at + 3]);
+    };
+    const std::uint32_t width = big_endian(16), height = big_endian(20);
+    if (width > 0x7fffffffu || height > 0x7fffffffu) return std::nullopt;
+    return ImageInfo{int(width), int(height), 0};
+}
+
+void require_pixel_limit(const std::string& path, const ImageInfo& info) {
+    if (info.width <= 0 || info.height <= 0)
+        fail_in_file(path, "the image declares " + std::to_string(info.width) + " x " +
+                               std::to_string(info.height) + " pixels");
+    if (static_cast<long long>(info.width) * info.height > kMaxImagePixels)
+        fail_in_file(path, "the image declares " + std::to_string(info.width) + " x " +
+                               std::to_string(info.height) + " pixels, more than the limit of " +
+                               std::to_string(kMaxImagePixels) + " (16384 x 8192)");
+}
+
+// stb_image decodes a cut .hdr as if the missing scanlines were black; refuse it instead.
+void require_complete_radiance(const std::string& path) {
+    const std::string bytes = read_text_file(path);  // binary mode, whole file
+    const std::span<const std::uint8_t> file(reinterpret_cast<const std::uint8_t*>(bytes.data()),
+                                             bytes.size());
+    RadianceLayout layout;
+    if (!parse_radiance_layout(file, layout))
+        fail_in_file(path,
+                     "corrupt Radiance HDR header (no '#?' signature, no blank line, or no resolution line)");
+    const int complete = complete_radiance_scanlines(file, layout);
+    if (complete < layout.height)
+        fail_in_file(path, "truncated or corrupt Radiance HDR: " + std::to_string(complete) + " of " +
+                               std::to_string(layout.height) + " scanlines are complete");
+}
+
 }  // namespace
 
 ImageInfo read_image_info(const std::string& path) {
     require_regular_file(path);
     if (is_exr(path)) return exr_info(path);
     ImageInfo info;
-    if (!stbi_info(path.c_str(), &info.width, &info.height, &info.channels))
+    if (!stbi_info(path.c_str(), &info.width, &info.height, &info.channels)) {
+        // stb refuses a PNG over 1 GiB of samples as "unknown image type": say what the header declares.
+        if (const std::optional<ImageInfo> declared = png_header_size(path))
+            require_pixel_limit(path, *declared);
         fail_in_file(path, "unsupported or corrupt image (" + stb_reason() + ")");
+    }
     return info;
 }
 
 Image read_image(const std::string& path) {
-    require_regular_file(path);
+    require_pixel_limit(path, read_image_info(path));
     if (is_exr(path)) return read_exr(path);
     // Radiance HDR is float radiance. stbi_loadf is used for it only: on 8-bit files it would apply a gamma.
-    if (stbi_is_hdr(path.c_str())) return decode_with_stb<float>(path, stbi_loadf, 1.0f);
+    if (stbi_is_hdr(path.c_str())) {
+        require_complete_radiance(path);
+        return decode_with_stb<float>(path, stbi_loadf, 1.0f);
+    }
     if (stbi_is_16_bit(path.c_str())) return decode_with_stb<stbi_us>(path, stbi_load_16, 65535.0f);
     return decode_with_stb<stbi_uc>(path, stbi_load, 255.0f);
 }
