@@ -38,7 +38,7 @@ ImageInfo read_image_info(const std::string& path);
 // PNG (8/16 bit), JPEG, Radiance .hdr, OpenEXR. Gray stays 1 channel, gray+alpha 2, RGB 3, RGBA 4; an EXR
 // gives 1 channel if it has one, 4 if it has an alpha channel, else 3 (R, G, B).
 // Throws Error naming the file if it is missing, corrupt, cut short (Radiance .hdr), larger than
-// kMaxImagePixels or of an unsupported format.
+// kMaxImagePixels, declaring more pixels than its bytes can encode, or of an unsupported format.
 Image read_image(const std::string& path);
 
 // 8 or 16 bit PNG with the image's channel count (1 to 4). Values are clamped to [0, 1] (NaN -> 0) and

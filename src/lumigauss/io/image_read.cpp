@@ -2,6 +2,7 @@
 #include <stb/stb_image.h>
 #include <tinyexr.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -124,6 +125,23 @@ void require_pixel_limit(const std::string& path, const ImageInfo& info) {
                                std::to_string(kMaxImagePixels) + " (16384 x 8192)");
 }
 
+// No image format decodes to more samples than this per byte of file: deflate (PNG, EXR ZIP) expands at most
+// 1032:1, a 1-bit palette PNG packs 8 pixels per byte and expands to 4 channels, and run-length and JPEG
+// entropy codes stay below that. A file declaring more is lying about its size, and is refused before stb or
+// tinyexr allocate for it: memory stays proportional to the file (a 100-byte file: at most 13 MB of floats).
+constexpr double kMaxSamplesPerFileByte = 32768;
+
+void require_plausible_size(const std::string& path, const ImageInfo& info) {
+    std::error_code ec;
+    const auto bytes = std::filesystem::file_size(path, ec);
+    if (ec) fail_in_file(path, "cannot read the file size (" + ec.message() + ")");
+    const double samples = double(info.width) * double(info.height) * double(std::max(info.channels, 1));
+    if (samples > kMaxSamplesPerFileByte * double(bytes))
+        fail_in_file(path, "the image declares " + std::to_string(info.width) + " x " +
+                               std::to_string(info.height) + " pixels, more than a file of " +
+                               std::to_string(bytes) + " bytes can hold (truncated or corrupt)");
+}
+
 // stb_image decodes a cut .hdr as if the missing scanlines were black; refuse it instead.
 void require_complete_radiance(const std::string& path) {
     const std::string bytes = read_text_file(path);  // binary mode, whole file
@@ -155,7 +173,9 @@ ImageInfo read_image_info(const std::string& path) {
 }
 
 Image read_image(const std::string& path) {
-    require_pixel_limit(path, read_image_info(path));
+    const ImageInfo info = read_image_info(path);
+    require_pixel_limit(path, info);
+    require_plausible_size(path, info);
     if (is_exr(path)) return read_exr(path);
     // Radiance HDR is float radiance. stbi_loadf is used for it only: on 8-bit files it would apply a gamma.
     if (stbi_is_hdr(path.c_str())) {
