@@ -1,0 +1,75 @@
+#include "fuzz_support.h"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace lumigauss::fuzz {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::string_view kSeparator = "\n--lumigauss-fuzz-part--\n";
+
+struct ScratchFolder {
+    fs::path path;
+    ScratchFolder() {
+        path = fs::temp_directory_path() / ("lumigauss_fuzz_" + std::to_string(::getpid()));
+        fs::create_directories(path);
+    }
+    ~ScratchFolder() {
+        std::error_code ec;
+        fs::remove_all(path, ec);
+    }
+};
+
+}  // namespace
+
+std::string scratch_path(const std::string& name) {
+    static ScratchFolder folder;
+    return (folder.path / name).string();
+}
+
+void write_file(const std::string& path, Bytes bytes) {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+}
+
+void write_file(const std::string& path, const std::string& bytes) {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+std::string read_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+std::string join_parts(const std::vector<std::string>& parts) {
+    std::string out;
+    for (std::size_t i = 0; i < parts.size(); ++i) out += (i > 0 ? std::string(kSeparator) : "") + parts[i];
+    return out;
+}
+
+std::vector<std::string> split_parts(Bytes input, std::size_t count) {
+    const std::string_view text(reinterpret_cast<const char*>(input.data()), input.size());
+    std::vector<std::string> parts;
+    std::size_t start = 0;
+    while (parts.size() + 1 < count) {
+        const std::size_t at = text.find(kSeparator, start);
+        if (at == std::string_view::npos) break;
+        parts.emplace_back(text.substr(start, at - start));
+        start = at + kSeparator.size();
+    }
+    parts.emplace_back(text.substr(start));
+    parts.resize(count);  // missing parts are empty files
+    return parts;
+}
+
+}  // namespace lumigauss::fuzz

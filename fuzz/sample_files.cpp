@@ -1,0 +1,37 @@
+#include "sample_files.h"
+
+#include <filesystem>
+#include <vector>
+
+namespace lumigauss::fuzz {
+
+ColmapModel sample_colmap_model() {
+    ColmapModel m;
+    m.cameras[1] = {1, "PINHOLE", 64, 48, {60.0, 61.0, 32.0, 24.0}};
+    m.cameras[2] = {2, "SIMPLE_PINHOLE", 32, 24, {30.0, 16.0, 12.0}};
+    m.images.push_back({1, "a.png", {1, 0, 0, 0}, {0, 0, 4}, 1});
+    m.images.push_back({2, "b.png", {0.9238795, 0, 0.3826834, 0}, {0.5, 0, 4}, 1});
+    m.images.push_back({3, "c.png", {0.7071068, 0.7071068, 0, 0}, {0, -1, 3}, 2});
+    m.point_xyz = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0.5f}, {-1, -1, 1}};
+    m.point_rgb = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.5f, 0.5f, 0.5f}};
+    return m;
+}
+
+SurfelModel sample_surfel_model() {
+    const std::size_t n = 3;
+    std::vector<std::vector<float>> raw;
+    for (const ModelParam p : kAllModelParams) {
+        std::vector<float> values(n * std::size_t(SurfelModel::width(p)));
+        for (std::size_t i = 0; i < values.size(); ++i) values[i] = 0.1f * float(i % 11) - 0.3f;
+        if (p == ModelParam::Rotation)
+            for (std::size_t i = 0; i < n; ++i) values[4 * i] = 1.0f;
+        raw.push_back(std::move(values));
+    }
+    return SurfelModel::from_raw(std::move(raw));
+}
+
+void make_folder(const std::string& dir) {
+    std::filesystem::create_directories(dir);
+}
+
+}  // namespace lumigauss::fuzz
