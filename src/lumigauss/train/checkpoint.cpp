@@ -1,5 +1,7 @@
 #include "lumigauss/train/checkpoint.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -11,19 +13,31 @@
 namespace lumigauss {
 namespace {
 
-// Version 2 adds the sky residuals after the lighting model; version 1 files (no residuals) still load.
-constexpr char kMagic[9] = "LGCKPT02";
+// Version 3 ends with a checksum of everything before it; version 2 added the sky residuals after the
+// lighting model. Versions 1 and 2 (no checksum) still load.
+constexpr char kMagic[9] = "LGCKPT03";
+constexpr char kMagicV2[9] = "LGCKPT02";
 constexpr char kMagicV1[9] = "LGCKPT01";
 constexpr char kEndMarker[9] = "LGCKEND1";
-// Sanity bound on any length field, so a corrupt length fails clearly instead of allocating terabytes.
-constexpr std::uint64_t kMaxElements = std::uint64_t(1) << 36;
+
+// FNV-1a, 64 bit: catches a flipped byte or an edited value anywhere in the file (it is not a defence against
+// someone forging a checkpoint, which would have to be run to matter).
+struct Checksum {
+    std::uint64_t state = 0xcbf29ce484222325ULL;
+    void add(const void* data, std::size_t bytes) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (std::size_t i = 0; i < bytes; ++i) state = (state ^ p[i]) * 0x100000001b3ULL;
+    }
+};
 
 class Writer {
   public:
     explicit Writer(std::ofstream& out) : out_(out) {}
     void raw(const void* data, std::size_t bytes) {
+        checksum_.add(data, bytes);
         out_.write(static_cast<const char*>(data), std::streamsize(bytes));
     }
+    std::uint64_t checksum() const { return checksum_.state; }
     template <typename T>
     void value(T v) {
         raw(&v, sizeof(T));
@@ -44,6 +58,7 @@ class Writer {
 
   private:
     std::ofstream& out_;
+    Checksum checksum_;
 };
 
 struct SavedAdam {
@@ -59,10 +74,16 @@ void restore_adam(AdamGroup& g, SavedAdam a, const std::string& path, const std:
 
 class Reader {
   public:
-    Reader(std::ifstream& in, const std::string& path) : in_(in), path_(path) {}
+    Reader(std::ifstream& in, const std::string& path) : in_(in), path_(path) {
+        in_.seekg(0, std::ios::end);
+        remaining_ = std::uint64_t(std::max<std::streamoff>(in_.tellg(), 0));
+        in_.seekg(0, std::ios::beg);
+    }
     void raw(void* data, std::size_t bytes, const char* what) {
         in_.read(static_cast<char*>(data), std::streamsize(bytes));
         if (!in_) fail_in_file(path_, std::string("truncated checkpoint (while reading ") + what + ")");
+        checksum_.add(data, bytes);
+        remaining_ -= bytes;
     }
     template <typename T>
     T value(const char* what) {
@@ -70,10 +91,14 @@ class Reader {
         raw(&v, sizeof(T), what);
         return v;
     }
-    std::uint64_t length(const char* what) {
+    // A count of elements of `element_bytes` each, checked against the bytes left in the file before anything
+    // is allocated for it.
+    std::uint64_t length(const char* what, std::uint64_t element_bytes = 1) {
         const auto n = value<std::uint64_t>(what);
-        if (n > kMaxElements)
-            fail_in_file(path_, std::string("corrupt checkpoint (impossible length of ") + what + ")");
+        if (n > remaining_ / std::max<std::uint64_t>(element_bytes, 1))
+            fail_in_file(path_, std::string("corrupt checkpoint (") + what + " declares " +
+                                    std::to_string(n) + " elements, more than the " +
+                                    std::to_string(remaining_) + " bytes left in the file)");
         return n;
     }
     std::string string(const char* what) {
@@ -82,7 +107,7 @@ class Reader {
         return s;
     }
     std::vector<float> floats(const char* what) {
-        std::vector<float> v(length(what));
+        std::vector<float> v(length(what, sizeof(float)));
         raw(v.data(), v.size() * sizeof(float), what);
         return v;
     }
@@ -94,11 +119,28 @@ class Reader {
         a.v = floats(what);
         return a;
     }
+    std::uint64_t checksum() const { return checksum_.state; }
 
   private:
     std::ifstream& in_;
     const std::string& path_;
+    std::uint64_t remaining_ = 0;
+    Checksum checksum_;
 };
+
+// Header fields a damaged or edited file could hold and training would otherwise run on.
+void check_header(const TrainState& s, const std::string& path) {
+    try {
+        validate_train_config(s.config);
+    } catch (const Error& e) {
+        fail_in_file(path, std::string("corrupt checkpoint (embedded config: ") + e.what() + ")");
+    }
+    if (s.iteration < 0 || s.iteration > s.config.iterations)
+        fail_in_file(path, "corrupt checkpoint (iteration " + std::to_string(s.iteration) + " outside 0.." +
+                               std::to_string(s.config.iterations) + ")");
+    if (!std::isfinite(s.scene_extent) || s.scene_extent <= 0)
+        fail_in_file(path, "corrupt checkpoint (scene extent " + std::to_string(s.scene_extent) + ")");
+}
 
 }  // namespace
 
@@ -132,6 +174,8 @@ void save_checkpoint(const std::string& path, const TrainState& s) {
         w.value<std::uint64_t>(s.sky_residual_adam.size());
         for (const AdamGroup& g : s.sky_residual_adam) w.adam(g);
         w.raw(kEndMarker, 8);
+        const std::uint64_t checksum = w.checksum();
+        out.write(reinterpret_cast<const char*>(&checksum), sizeof checksum);
         out.flush();
         if (!out) fail_in_file(tmp, "write failed (disk full?)");
     });
@@ -144,7 +188,8 @@ TrainState load_checkpoint(const std::string& path) {
     char magic[8];
     r.raw(magic, 8, "magic");
     const bool version1 = std::memcmp(magic, kMagicV1, 8) == 0;
-    if (!version1 && std::memcmp(magic, kMagic, 8) != 0)
+    const bool version2 = std::memcmp(magic, kMagicV2, 8) == 0;
+    if (!version1 && !version2 && std::memcmp(magic, kMagic, 8) != 0)
         fail_in_file(path, "not a LumiGauss checkpoint (wrong magic)");
 
     TrainState s;
@@ -152,10 +197,11 @@ TrainState load_checkpoint(const std::string& path) {
     apply_train_config_json(s.config, r.string("config"), path + " (embedded config)");
     s.iteration = r.value<std::int64_t>("iteration");
     s.scene_extent = r.value<double>("scene extent");
-    const auto names = r.length("photo count");
+    check_header(s, path);
+    const auto names = r.length("photo count", sizeof(std::uint64_t));
     for (std::uint64_t i = 0; i < names; ++i) s.image_names.push_back(r.string("photo name"));
 
-    const auto surfels = r.length("surfel count");
+    const auto surfels = r.length("surfel count", sizeof(float));
     std::vector<std::vector<float>> raw(kModelParamCount);
     std::vector<SavedAdam> adam(kModelParamCount);
     for (int p = 0; p < kModelParamCount; ++p) {
@@ -192,7 +238,7 @@ TrainState load_checkpoint(const std::string& path) {
     }
     if (!version1) {
         std::vector<float> residuals = r.floats("sky residuals");
-        const auto groups = r.length("sky residual optimizers");
+        const auto groups = r.length("sky residual optimizers", sizeof(std::int64_t));
         if (!residuals.empty() || groups != 0) {
             if (residuals.size() != std::size_t(images) * SkyResiduals::kRowWidth ||
                 groups != std::uint64_t(images))
@@ -207,6 +253,16 @@ TrainState load_checkpoint(const std::string& path) {
     char end[8];
     r.raw(end, 8, "end marker");
     if (std::memcmp(end, kEndMarker, 8) != 0) fail_in_file(path, "corrupt checkpoint (no end marker)");
+    if (!version1 && !version2) {
+        const std::uint64_t computed = r.checksum();
+        if (r.value<std::uint64_t>("checksum") != computed)
+            fail_in_file(path, "corrupt checkpoint (checksum mismatch: the file was damaged or edited)");
+    }
+    for (const ModelParam p : kAllModelParams)
+        for (const float v : s.model.param(p))
+            if (!std::isfinite(v))
+                fail_in_file(path,
+                             std::string("corrupt checkpoint (a non-finite ") + GaussianModel::name(p) + ")");
     return s;
 }
 
