@@ -422,6 +422,9 @@ TEST(TrainConfigJson, NotJsonOrNotAnObject) {
                 AllOf(HasSubstr("run/config.json"), HasSubstr("not valid JSON")));
     EXPECT_THAT(json_error(""), AllOf(HasSubstr("run/config.json"), HasSubstr("not valid JSON")));
     EXPECT_THAT(json_error("{\"iterations\": 10} trailing"), HasSubstr("not valid JSON"));
+    // A number out of double's range was an internal error (nlohmann's out_of_range), found by fuzz_train_config.
+    EXPECT_THAT(json_error("{\"lambda_shadow\": 1e400}"),
+                AllOf(HasSubstr("run/config.json"), HasSubstr("not valid JSON")));
     for (const char* text : {"[1, 2]", "42", "\"paper\"", "null"}) {
         EXPECT_THAT(json_error(text, "--config"), AllOf(HasSubstr("--config"), HasSubstr("object"))) << text;
     }

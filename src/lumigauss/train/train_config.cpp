@@ -417,7 +417,7 @@ void apply_train_config_json(TrainConfig& config, std::string_view json_text, st
     Json j;
     try {
         j = Json::parse(json_text.begin(), json_text.end());
-    } catch (const Json::parse_error& e) {
+    } catch (const Json::exception& e) {  // parse_error, and out_of_range for a number like 1e400
         throw Error(std::string(source) + ": not valid JSON: " + e.what());
     }
     if (!j.is_object()) {
