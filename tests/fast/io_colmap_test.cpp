@@ -147,6 +147,21 @@ TEST(ColmapErrors, TruncatedBinary) {
     expect_error([&] { read_colmap_binary(tmp / "m"); }, {"points3D.bin", "truncated"});
 }
 
+// A cut images.txt gave 5 of 10 views (the test views vanished) and a cut points3D.txt 81 of 219 points,
+// silently. COLMAP's "# Number of ..." header now says how many records there must be.
+TEST(ColmapErrors, TextCutAtALineBoundaryIsRefused) {
+    for (const char* file : {"cameras.txt", "images.txt", "points3D.txt"}) {
+        TempDir tmp;
+        write_colmap_text(tmp / "m", test::small_model(3, 8, 6));
+        const std::string path = tmp / (std::string("m/") + file);
+        const std::string text = test::read_text(path);
+        const std::size_t cut = text.rfind('\n', text.size() - 2);  // drop the last line
+        const std::size_t keep = std::string(file) == "images.txt" ? text.rfind('\n', cut - 1) : cut;
+        test::write_text(path, text.substr(0, keep + 1));
+        expect_error([&] { (void)read_colmap_text(tmp / "m"); }, {file, "declares", "cut short"});
+    }
+}
+
 TEST(ColmapErrors, ImageWithUnknownCameraId) {
     TempDir tmp;
     ColmapModel m = test::small_model(3, 8, 6);

@@ -224,6 +224,11 @@ TEST(DatasetColmap, SplitFileAndMaskNaming) {
 
     test::write_text(tmp / "scene_split.csv", "img_0.png;train\nimg_1.png;train\nimg_2.png;test\n");
     expect_error([&] { load_dataset(tmp.path().string()); }, {"scene_split.csv", "img_3.png", "not listed"});
+    // A listed test photo the model lacks: its views vanished from every score (a cut images.txt).
+    test::write_text(tmp / "scene_split.csv",
+                     "img_0.png;train\nimg_1.png;train\nimg_2.png;test\nimg_3.png;test\nlost.png;test\n");
+    expect_error([&] { load_dataset(tmp.path().string()); },
+                 {"scene_split.csv", "lost.png", "does not have"});
     test::write_text(tmp / "scene_split.csv", "filename;split\nimg_0.png;train\nimg_1.png;holdout\n");
     expect_error([&] { load_dataset(tmp.path().string()); }, {"scene_split.csv", "line 3", "'holdout'"});
 }

@@ -35,13 +35,23 @@ class Lines {
         return true;
     }
 
-    // The next line that is neither empty nor a comment.
+    // The next line that is neither empty nor a comment. Notes the count of a "# Number of ...: N" comment,
+    // which COLMAP writes at the top of each file.
     bool next_record(std::string_view& line) {
         while (next(line)) {
             const std::size_t first = line.find_first_not_of(" \t");
             if (first != std::string_view::npos && line[first] != '#') return true;
+            note_declared_count(line);
         }
         return false;
+    }
+
+    // A file cut short (a copy interrupted, a disk full) still parses, one record short of what COLMAP wrote.
+    void check_declared_count(std::size_t records, const char* what) const {
+        if (declared_ && *declared_ != records)
+            fail_in_file(path_, "holds " + std::to_string(records) + " " + what +
+                                    " but its header declares " + std::to_string(*declared_) +
+                                    " (cut short, or edited without the header)");
     }
 
     [[noreturn]] void fail(const std::string& what) const {
@@ -51,10 +61,23 @@ class Lines {
     std::string where() const { return "line " + std::to_string(number_); }
 
   private:
+    void note_declared_count(std::string_view line) {
+        constexpr std::string_view kPrefix = "# Number of ";
+        if (declared_ || !line.starts_with(kPrefix)) return;
+        const std::size_t colon = line.find(':');
+        if (colon == std::string_view::npos) return;
+        const std::size_t start = line.find_first_not_of(' ', colon + 1);
+        if (start == std::string_view::npos) return;
+        std::size_t n = 0;
+        const auto [end, ec] = std::from_chars(line.data() + start, line.data() + line.size(), n);
+        if (ec == std::errc()) declared_ = n;
+    }
+
     std::string path_;
     std::string text_;
     std::size_t pos_ = 0;
     int number_ = 0;
+    std::optional<std::size_t> declared_;
 };
 
 std::vector<std::string_view> split(std::string_view line) {
@@ -98,6 +121,7 @@ std::map<int, ColmapCamera> read_cameras(const std::string& path) {
         if (!cameras.emplace(cam.id, cam).second)
             lines.fail("camera_id " + std::to_string(cam.id) + " repeated");
     }
+    lines.check_declared_count(cameras.size(), "cameras");
     return cameras;
 }
 
@@ -132,6 +156,7 @@ std::vector<ColmapImage> read_images(const std::string& path, const std::map<int
         // The observations line always follows (empty when the image has none); at the end it may be absent.
         if (lines.next(line)) check_points2d_line(line, lines);
     }
+    lines.check_declared_count(images.size(), "images");
     return images;
 }
 
@@ -154,6 +179,7 @@ void read_points(const std::string& path, ColmapModel& model) {
         model.point_xyz.push_back(xyz);
         model.point_rgb.push_back(rgb);
     }
+    lines.check_declared_count(model.point_xyz.size(), "points");
 }
 
 // Text output: strings as they are, numbers in the shortest form that reads back to the same value.

@@ -1,6 +1,8 @@
 // The COLMAP layout: sparse/0 (or sparse) + images/ [+ masks/] [+ sky_masks/] [+ *split.csv].
 #include <algorithm>
 #include <filesystem>
+#include <set>
+#include <string>
 
 #include "lumigauss/io/colmap.h"
 #include "lumigauss/io/dataset_detail.h"
@@ -102,6 +104,26 @@ void assign_splits(std::vector<RawView>& views, const std::string& root, int hol
         if (it == splits.end())
             fail_in_file(split_path, "image " + r.view.name + " is not listed (every image needs a split)");
         r.view.split = it->second;
+    }
+    // The other way round: a test or validation photo the split file lists but the model lacks (a cut
+    // images.txt lost the test views without a word, and the scores changed meaning). A training photo COLMAP
+    // could not register is common and stays allowed.
+    std::set<std::string> known;
+    for (const RawView& r : views)
+        known.insert(r.view.name), known.insert(fs::path(r.view.name).filename().string());
+    std::vector<std::string> missing;
+    for (const auto& [name, split] : splits)
+        if (split != Split::Train && !known.count(name)) missing.push_back(name);
+    if (!missing.empty()) {
+        std::string names;
+        for (std::size_t i = 0; i < std::min<std::size_t>(missing.size(), 3); ++i)
+            names += (i ? ", " : "") + missing[i];
+        fail_in_file(split_path,
+                     "lists " + std::to_string(missing.size()) +
+                         " test or validation image(s) the COLMAP model does not have (" + names +
+                         (missing.size() > 3 ? ", ..." : "") +
+                         "): a cut or different images.txt, or the split file of another scene; if "
+                         "COLMAP could not register them, remove them from the split file");
     }
 }
 
