@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <random>
@@ -205,6 +207,17 @@ TEST(TrainMlp, LoadRejectsBadFiles) {
     };
     EXPECT_THROW(load_lighting_mlp(write("truncated.bin", bytes.substr(0, bytes.size() - 4))), Error);
     EXPECT_THROW(load_lighting_mlp(write("trailing.bin", bytes + "x")), Error);
+    // A photo count of 2^25 in a file of a few kilobytes allocated 4.8 GB (found by fuzz_lighting_files): the
+    // count is checked against the file's size first.
+    std::string many = bytes;
+    const std::int32_t photos = 1 << 25;
+    std::memcpy(many.data() + 8, &photos, sizeof photos);
+    try {
+        load_lighting_mlp(write("many.bin", many));
+        ADD_FAILURE() << "a photo count the file cannot hold was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("wrong photo count"), std::string::npos) << e.what();
+    }
     std::string bad_magic = bytes;
     bad_magic[0] = 'X';
     EXPECT_THROW(load_lighting_mlp(write("magic.bin", bad_magic)), Error);

@@ -58,8 +58,10 @@ ImageInfo exr_info(const std::string& path) {
     EXRHeader header;
     InitEXRHeader(&header);
     const char* err = nullptr;
-    if (ParseEXRHeaderFromFile(&header, &version, path.c_str(), &err) != TINYEXR_SUCCESS)
+    if (ParseEXRHeaderFromFile(&header, &version, path.c_str(), &err) != TINYEXR_SUCCESS) {
+        FreeEXRHeader(&header);  // what it parsed before failing (found leaking by fuzz_image)
         fail_exr(path, "corrupt OpenEXR header", err);
+    }
     ImageInfo info;
     info.width = header.data_window.max_x - header.data_window.min_x + 1;
     info.height = header.data_window.max_y - header.data_window.min_y + 1;

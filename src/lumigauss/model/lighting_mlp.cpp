@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <random>
 
@@ -189,6 +190,18 @@ LightingMlp load_lighting_mlp(const std::string& path) {
         header[4] != kMlpGroupCount)
         fail_in_file(path, "lighting MLP dimensions differ from 24-64-64-27 (or a negative image count)");
 
+    // The photo count sizes the embedding: check it against the file before allocating for it.
+    std::size_t expected_floats = std::size_t(header[0]) * kEmbeddingDim;
+    const LightingMlp no_photos(0, 0);
+    for (int gi = 0; gi < kMlpGroupCount; ++gi)
+        expected_floats += no_photos.param(static_cast<MlpGroup>(gi)).size();
+    const auto file_bytes = std::filesystem::file_size(path);
+    const std::size_t header_bytes = sizeof magic + sizeof header;
+    if (file_bytes != header_bytes + expected_floats * sizeof(float))
+        fail_in_file(path, "holds " + std::to_string(file_bytes) + " bytes, but a lighting MLP of " +
+                               std::to_string(header[0]) + " photos takes " +
+                               std::to_string(header_bytes + expected_floats * sizeof(float)) +
+                               " (truncated, or a wrong photo count)");
     LightingMlp mlp(header[0], 0);
     for (int gi = 0; gi < kMlpGroupCount; ++gi) {
         auto& v = mlp.param(static_cast<MlpGroup>(gi));

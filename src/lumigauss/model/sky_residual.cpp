@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 
 #include "lumigauss/io/atomic_file.h"
@@ -50,6 +51,8 @@ void save_sky_residuals(const std::string& path, const SkyResiduals& residuals) 
     write_file_atomically(path, bytes);
 }
 
+constexpr std::size_t kRowBytes = SkyResiduals::kRowWidth * sizeof(float);
+
 SkyResiduals load_sky_residuals(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) fail_in_file(path, "cannot open the sky residual file");
@@ -61,6 +64,11 @@ SkyResiduals load_sky_residuals(const std::string& path) {
     read_exact(in, path, header, sizeof header);
     if (header[0] < 0 || header[0] > kMaxImages || header[1] != kSh4Count)
         fail_in_file(path, "sky residual dimensions are not N photos x 25 coefficients");
+    const std::size_t expected = sizeof magic + sizeof header + std::size_t(header[0]) * kRowBytes;
+    if (std::filesystem::file_size(path) != expected)
+        fail_in_file(path, "holds " + std::to_string(std::filesystem::file_size(path)) + " bytes, but " +
+                               std::to_string(header[0]) + " photos' residuals take " +
+                               std::to_string(expected) + " (truncated, or a wrong photo count)");
     SkyResiduals r(header[0]);
     read_exact(in, path, r.params().data(), r.params().size() * sizeof(float));
     if (in.peek() != std::ifstream::traits_type::eof())
