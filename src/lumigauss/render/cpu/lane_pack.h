@@ -17,6 +17,7 @@
 #include "lumigauss/math/exp2_eighths.h"
 #include "lumigauss/math/lanes.h"
 #include "lumigauss/render/cpu/streaming_store.h"
+#include "lumigauss/render/cpu/vector_shuffle.h"
 
 namespace lumigauss::cpu {
 
@@ -46,7 +47,7 @@ struct LaneInt {
     V v;
     LaneInt() = default;
     constexpr LaneInt(V x) : v(x) {}
-    LaneInt(I s) : v(__builtin_shuffle(V{s}, V{})) {}  // broadcast (see Pack)
+    LaneInt(I s) : v(LG_SHUFFLE(V{s}, V{})) {}  // broadcast (see Pack)
     I operator[](int i) const { return v[i]; }
     friend LaneInt operator&(LaneInt a, LaneInt b) { return {a.v & b.v}; }
     friend LaneInt operator|(LaneInt a, LaneInt b) { return {a.v | b.v}; }
@@ -68,7 +69,7 @@ struct Pack {
     // Broadcast, spelled as lane 0 shuffled into every lane: GCC 12 compiles that to one broadcast, while
     // `s - V{}` or a lane-by-lane initialiser in a constructor become chains of inserts, and `V{} + s`
     // costs an add (0 + -0 is +0).
-    Pack(T s) : v(__builtin_shuffle(V{s}, typename Index::V{})) {}  // implicit: formulas mix packs, scalars
+    Pack(T s) : v(LG_SHUFFLE(V{s}, typename Index::V{})) {}  // implicit: formulas mix packs, scalars
     template <typename U>
     requires std::is_arithmetic_v<U>
     explicit Pack(U s) : Pack(static_cast<T>(s)) {}  // L(constant), as T(constant) for a scalar
@@ -128,9 +129,9 @@ inline unsigned any_of_each(Mask8<T> a, Mask8<T> b) {
     // copy took four more instructions).
     using V = typename Int8<T>::V;
     V bits = (a.v & 1) | (b.v & 2);
-    bits |= __builtin_shuffle(bits, V{4, 5, 6, 7, 0, 1, 2, 3});
-    bits |= __builtin_shuffle(bits, V{2, 3, 0, 1, 2, 3, 0, 1});
-    bits |= __builtin_shuffle(bits, V{1, 0, 1, 0, 1, 0, 1, 0});
+    bits |= LG_SHUFFLE(bits, V{4, 5, 6, 7, 0, 1, 2, 3});
+    bits |= LG_SHUFFLE(bits, V{2, 3, 0, 1, 2, 3, 0, 1});
+    bits |= LG_SHUFFLE(bits, V{1, 0, 1, 0, 1, 0, 1, 0});
     return unsigned(bits[0]);
 }
 
@@ -141,7 +142,7 @@ inline Pack8<float> exp2_eighths(Pack8<float> shifted) {
     const IV n = (IV)shifted.v - kExpRoundMagicBits;  // GCC vector cast: the same bits reinterpreted
     const Pack8<float>::V table = {kExp2Eighths[0], kExp2Eighths[1], kExp2Eighths[2], kExp2Eighths[3],
                                    kExp2Eighths[4], kExp2Eighths[5], kExp2Eighths[6], kExp2Eighths[7]};
-    const IV bits = (IV)__builtin_shuffle(table, n) + (n >> 3) * (1 << 23);
+    const IV bits = (IV)LG_SHUFFLE(table, n) + (n >> 3) * (1 << 23);
     return {(Pack8<float>::V)bits};
 }
 
@@ -189,7 +190,7 @@ template <typename T>
 inline void transpose_packs(Pack8<T> (&m)[kLanes]) {
     using IV = typename Int8<T>::V;
     const auto mix = [](Pack8<T> a, Pack8<T> b, IV order) {
-        return Pack8<T>{__builtin_shuffle(a.v, b.v, order)};
+        return Pack8<T>{LG_SHUFFLE(a.v, b.v, order)};
     };
     const IV lo1{0, 8, 1, 9, 4, 12, 5, 13}, hi1{2, 10, 3, 11, 6, 14, 7, 15};  // pairs of rows interleaved
     const IV lo2{0, 1, 8, 9, 4, 5, 12, 13}, hi2{2, 3, 10, 11, 6, 7, 14, 15};  // then pairs of pairs
@@ -217,7 +218,7 @@ template <typename T>
 inline Pack8<T> lane_sums(const Pack8<T>* q) {
     using IV = typename Int8<T>::V;
     const auto fold = [](Pack8<T> a, Pack8<T> b, IV lo, IV hi) {
-        return Pack8<T>{__builtin_shuffle(a.v, b.v, lo) + __builtin_shuffle(a.v, b.v, hi)};
+        return Pack8<T>{LG_SHUFFLE(a.v, b.v, lo) + LG_SHUFFLE(a.v, b.v, hi)};
     };
     // Level 1: lanes two apart, a's and b's interleaved. These are the unpack-low / unpack-high patterns,
     // one in-lane instruction each with AVX2 too (the neighbour pairs {0, 8, 2, 10, ...} took a permute

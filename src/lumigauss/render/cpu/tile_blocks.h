@@ -19,6 +19,7 @@
 
 #include "lumigauss/math/hd.h"
 #include "lumigauss/render/cpu/bit_transpose.h"
+#include "lumigauss/render/cpu/vector_shuffle.h"
 #include "lumigauss/render/cpu/lane_pack.h"
 #include "lumigauss/render/cpu/raster_state.h"
 #include "lumigauss/render/splat_reach.h"
@@ -166,7 +167,7 @@ LG_HD_INLINE void append_group(const std::uint32_t (&masks)[kLanes], std::uint32
     Bytes mask_bytes;
     std::memcpy(&mask_bytes, masks, sizeof(mask_bytes));
     const Bytes by_word =
-        __builtin_shuffle(mask_bytes, Bytes{0, 4, 8,  12, 16, 20, 24, 28, 1, 5, 9,  13, 17, 21, 25, 29,
+        LG_SHUFFLE(mask_bytes, Bytes{0, 4, 8,  12, 16, 20, 24, 28, 1, 5, 9,  13, 17, 21, 25, 29,
                                             2, 6, 10, 14, 18, 22, 26, 30, 3, 7, 11, 15, 19, 23, 27, 31});
     std::uint64_t words[kTileBlocks / 8];
     std::memcpy(words, &by_word, sizeof(words));
