@@ -216,6 +216,10 @@ TEST(RelightCameras, BadCameraJsonNamesTheFileAndTheEntry) {
             "R": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "t": [0, 2]}])",
          "cameras[0]: needs \"t\""},
         {"[" + good + ", " + good + "]", "cameras[1]: name 'ok' is used twice"},
+        // A render allocates its buffers for the camera: 10^6 x 10^6 was accepted.
+        {R"([{"width": 1000000, "height": 1000000, "fx": 5, "fy": 5, "cx": 4, "cy": 3,
+            "R": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "t": [0, 0, 2]}])",
+         "cameras[0]: 1000000 x 1000000 pixels is over the limit"},
         {R"([{"name": "../x", "width": 8, "height": 6, "fx": 5, "fy": 5, "cx": 4, "cy": 3,
             "R": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "t": [0, 0, 2]}])",
          "cameras[0]: name '../x'"},

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "lumigauss/io/atomic_file.h"
+#include "lumigauss/io/image.h"
 #include "lumigauss/io/text_file.h"
 #include "lumigauss/util/error.h"
 
@@ -114,6 +115,11 @@ std::vector<NamedCamera> read_camera_json(const std::string& path) {
         Camera& c = nc.camera;
         c.width = size_field(e, "width", path, where);
         c.height = size_field(e, "height", path, where);
+        // Every render allocates its frame buffers for this size: 10^6 x 10^6 was accepted.
+        if (static_cast<long long>(c.width) * c.height > kMaxImagePixels)
+            fail_in_file(path, where + ": " + std::to_string(c.width) + " x " + std::to_string(c.height) +
+                                   " pixels is over the limit of " + std::to_string(kMaxImagePixels) +
+                                   " (16384 x 8192)");
         c.fx = number_field(e, "fx", path, where);
         c.fy = number_field(e, "fy", path, where);
         c.cx = number_field(e, "cx", path, where);
