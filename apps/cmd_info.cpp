@@ -55,6 +55,9 @@ void print_views(const Dataset& d, const std::string& mask_mode) {
 
 void print_extent(const Dataset& d) {
     std::printf("points:        %zu\n", d.point_xyz.size());
+    if (d.far_points_dropped > 0)
+        std::printf("               (%zu more dropped: farther than %.4g from the cameras' centre)\n",
+                    d.far_points_dropped, d.far_point_limit);
     const CameraExtent e = camera_extent(d.views);
     std::printf("camera centre: mean (%.4g, %.4g, %.4g), extent %.4g (1.1 x max distance from the mean)\n",
                 e.center.x, e.center.y, e.center.z, e.radius);

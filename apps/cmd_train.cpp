@@ -130,6 +130,11 @@ int run_train(const TrainFlags& f) {
         std::printf("train: %zu photos, %zu SfM points, preset %s, %lld iterations -> %s\n",
                     trainer.views().size(), run.sfm_points(), config.preset.c_str(),
                     (long long)config.iterations, f.out.c_str());
+    if (run.far_points_dropped() > 0)
+        std::printf(
+            "train: dropped %zu SfM point(s) more than %.4g from the cameras' centre (1000x their "
+            "radius: failed triangulations)\n",
+            run.far_points_dropped(), run.far_point_limit());
     std::fflush(stdout);
     if (request.backend != RasterBackend::Cpu && !f.quiet)
         std::printf("train: rasterizing on %s\n", backend_description(request.backend).c_str());

@@ -233,6 +233,25 @@ TEST(DatasetColmap, SplitFileAndMaskNaming) {
     expect_error([&] { load_dataset(tmp.path().string()); }, {"scene_split.csv", "line 3", "'holdout'"});
 }
 
+// One SfM point at 1e20 (a failed triangulation) made the initial surfel scale overflow and training stop at
+// iteration 1 blaming the learning rates. Such points are dropped at load, and counted.
+TEST(DatasetColmap, AbsurdlyFarPointsAreDropped) {
+    TempDir tmp;
+    ColmapModel m = test::small_model(4, 8, 6);
+    const std::size_t points = m.point_xyz.size();
+    m.point_xyz.push_back({1e20f, 0, 0});
+    m.point_rgb.push_back({1, 1, 1});
+    m.point_xyz.push_back({0, -3e7f, 1});
+    m.point_rgb.push_back({1, 1, 1});
+    test::write_scene(tmp.path(), m);
+    const Dataset d = load_dataset(tmp.path().string());
+    EXPECT_EQ(d.point_xyz.size(), points);
+    EXPECT_EQ(d.point_rgb.size(), points);
+    EXPECT_EQ(d.far_points_dropped, 2u);
+    EXPECT_GT(d.far_point_limit, 0.0);
+    for (const Vec3f& p : d.point_xyz) EXPECT_LT(std::abs(p.x) + std::abs(p.y) + std::abs(p.z), 1e6f);
+}
+
 TEST(DatasetColmap, ImagesInSubfolders) {
     TempDir tmp;
     ColmapModel m = test::small_model(2, 8, 6);

@@ -106,6 +106,31 @@ std::vector<const View*> Dataset::split(Split which) const {
     return out;
 }
 
+namespace {
+
+// Drops the SfM points farther than kFarPointRadii x the cameras' radius from their centroid (a point at 1e20
+// from a bad triangulation overflowed the initial surfel scale at iteration 1).
+void drop_far_points(Dataset& d) {
+    if (d.views.empty() || d.point_xyz.empty()) return;
+    Vec3d centroid{};
+    for (const View& v : d.views) centroid = centroid + v.camera.center();
+    centroid = (1.0 / double(d.views.size())) * centroid;
+    double radius = 0;
+    for (const View& v : d.views) radius = std::max(radius, length(v.camera.center() - centroid));
+    if (!(radius > 0)) return;  // one camera (or all at one place): no scale to judge by
+    d.far_point_limit = kFarPointRadii * radius;
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < d.point_xyz.size(); ++i) {
+        const Vec3f& p = d.point_xyz[i];
+        if (length(Vec3d{p.x, p.y, p.z} - centroid) > d.far_point_limit) continue;
+        d.point_xyz[kept] = p, d.point_rgb[kept] = d.point_rgb[i], ++kept;
+    }
+    d.far_points_dropped = d.point_xyz.size() - kept;
+    d.point_xyz.resize(kept), d.point_rgb.resize(kept);
+}
+
+}  // namespace
+
 Dataset load_dataset(const std::string& root, const DatasetOptions& options) {
     const int f = options.downscale;
     if (f != 1 && f != 2 && f != 4 && f != 8)
@@ -132,6 +157,7 @@ Dataset load_dataset(const std::string& root, const DatasetOptions& options) {
     d.point_rgb = std::move(raw.point_rgb);
     d.views.reserve(raw.views.size());
     for (const RawView& r : raw.views) d.views.push_back(finish_view(r, f));
+    drop_far_points(d);
     return d;
 }
 

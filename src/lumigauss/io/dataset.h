@@ -45,12 +45,18 @@ struct View {
     int source_width = 0, source_height = 0;  // the image file's size, before downscaling
 };
 
+inline constexpr double kFarPointRadii = 1000.0;
+
 struct Dataset {
     std::string root;
     std::string format;                       // "colmap-binary", "colmap-text" or "nerf-osr"
     std::vector<View> views;                  // sorted by name
     std::vector<Vec3f> point_xyz, point_rgb;  // SfM points (rgb in 0..1); empty for NeRF-OSR
     int downscale = 1;
+    // SfM points dropped at load for lying absurdly far from the cameras (kFarPointRadii x the cameras'
+    // radius about their centroid): one point at 1e20 made the initial surfel scale overflow.
+    std::size_t far_points_dropped = 0;
+    double far_point_limit = 0;  // the distance from the cameras' centroid beyond which they were dropped
 
     // RGB in [0, 1] (gray is replicated, alpha dropped), resized by the downscale factor. Throws Error naming
     // the file if it cannot be read or its size is not the camera's.

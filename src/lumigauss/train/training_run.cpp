@@ -63,6 +63,8 @@ TrainingRun::TrainingRun(const TrainingRunRequest& request) : paths_(run_paths(r
         dopt.downscale = request.config.downscale;
         const Dataset data = load_dataset(request.scene, dopt);
         sfm_points_ = data.point_xyz.size();
+        far_points_dropped_ = data.far_points_dropped;
+        far_point_limit_ = data.far_point_limit;
         trainer_ =
             std::make_unique<Trainer>(load_train_views(data), data.point_xyz, data.point_rgb, request.config);
         std::filesystem::create_directories(request.out);  // only once the input is known to be good

@@ -49,6 +49,9 @@ class TrainingRun {
     const RunPaths& paths() const { return paths_; }
     bool resumed() const { return resumed_; }
     std::size_t sfm_points() const { return sfm_points_; }
+    // SfM points the dataset dropped for lying absurdly far from the cameras, and beyond what distance.
+    std::size_t far_points_dropped() const { return far_points_dropped_; }
+    double far_point_limit() const { return far_point_limit_; }
     // The message of the non-finite value that ended run() (TrainingOutcome::NonFinite).
     const std::string& failure() const { return failure_; }
     double elapsed_seconds() const;  // in run(), this process
@@ -60,6 +63,8 @@ class TrainingRun {
     std::unique_ptr<Trainer> trainer_;
     bool resumed_ = false;
     std::size_t sfm_points_ = 0;
+    std::size_t far_points_dropped_ = 0;
+    double far_point_limit_ = 0;
     std::string failure_;
     double elapsed_ = 0;
 };
