@@ -49,8 +49,10 @@ double peak_memory_mib() {
 TrainConfig config_from_flags(const TrainFlags& f) {
     TrainConfig c = train_preset(f.preset);
     if (!f.config_file.empty()) apply_train_config_json(c, read_text_file(f.config_file), f.config_file);
+    // --iterations scales the schedule so that a short run still reaches every stage; a --set key is taken
+    // as given, after it.
+    if (f.iterations > 0) scale_schedule(c, f.iterations);
     for (const auto& o : f.overrides) apply_train_config_override(c, o);
-    if (f.iterations > 0) c.iterations = f.iterations;
     if (f.downscale > 0) c.downscale = f.downscale;
     validate_train_config(c);
     return c;
@@ -130,6 +132,14 @@ int run_train(const TrainFlags& f) {
         std::printf("train: %zu photos, %zu SfM points, preset %s, %lld iterations -> %s\n",
                     trainer.views().size(), run.sfm_points(), config.preset.c_str(),
                     (long long)config.iterations, f.out.c_str());
+    if (!run.resumed()) {
+        std::printf("train: %s\n", schedule_summary(config).c_str());
+        if (config.iterations <= config.start_shadowed)
+            std::printf(
+                "train: warning: the run ends at iteration %lld, before the shadowed stage (%lld): its "
+                "shadowed renders and shadows are not trained\n",
+                (long long)config.iterations, (long long)config.start_shadowed + 1);
+    }
     if (run.far_points_dropped() > 0)
         std::printf(
             "train: dropped %zu SfM point(s) more than %.4g from the cameras' centre (1000x their "
@@ -189,7 +199,9 @@ void register_train(CLI::App& app) {
                     "official LumiGauss, for reproducing it) or paper-fast")
         ->check(CLI::IsMember(train_preset_names()))
         ->capture_default_str();
-    cmd->add_option("--iterations", f->iterations, "Total iterations (overrides the preset)")
+    cmd->add_option("--iterations", f->iterations,
+                    "Total iterations; the preset's schedule (stages, densification, resets) scales with it "
+                    "(with --resume: only extends the run)")
         ->check(CLI::PositiveNumber);
     cmd->add_option("-r,--resolution", f->downscale, "Downscale the photos by 1, 2, 4 or 8")
         ->check(CLI::IsMember({1, 2, 4, 8}));

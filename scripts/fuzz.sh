@@ -25,7 +25,7 @@ for t in "${targets[@]}"; do
     mkdir -p "$corpus" "$findings"
     LUMIGAUSS_FUZZ_WRITE_SEEDS=$seeds "build-fuzz/fuzz/fuzz_$t" > /dev/null
     log=build-fuzz/fuzz_$t.log
-    if "build-fuzz/fuzz/fuzz_$t" "$corpus" "$seeds" -max_total_time="$seconds" -rss_limit_mb=2048 \
+    if LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp "build-fuzz/fuzz/fuzz_$t" "$corpus" "$seeds" -max_total_time="$seconds" -rss_limit_mb=2048 \
         -malloc_limit_mb=2048 -timeout=10 -max_len=65536 -print_final_stats=1 \
         -artifact_prefix="$findings/" > "$log" 2>&1; then
         finding=none

@@ -225,6 +225,21 @@ TEST(CliTrain, ExistingRunNeedsResumeOrForce) {
               (std::vector<std::int64_t>{5, 10, 15, 20, 25, 30}));
 }
 
+// --iterations scales the preset's schedule (issue #28): a 30-iteration fast run reaches the shadowed stage
+// and says so; a --set stage boundary past the end is kept and warned about.
+TEST(CliTrain, IterationsScaleTheScheduleAndAShortStageIsWarnedAbout) {
+    TempDir tmp("cli_train_schedule");
+    const CommandResult scaled = run_lumigauss(train_args(tmp / "a", " --preset fast --iterations 30"), tmp);
+    ASSERT_EQ(scaled.exit_code, 0) << scaled.output;
+    EXPECT_THAT(scaled.output, HasSubstr("stages: unshadowed 1-14, transfer fitting 15-16, shadowed 17-30"));
+    EXPECT_THAT(scaled.output, ::testing::Not(HasSubstr("warning")));
+    EXPECT_EQ(synth_test::read_json(tmp / "a/config.json")["start_shadowed"], 16);
+    const CommandResult kept =
+        run_lumigauss(train_args(tmp / "b", " --preset fast --iterations 30 --set start_shadowed=40"), tmp);
+    ASSERT_EQ(kept.exit_code, 0) << kept.output;
+    EXPECT_THAT(kept.output, HasSubstr("warning: the run ends at iteration 30, before the shadowed stage (41)"));
+}
+
 // --backend: the rasterizer's backend. auto trains on the CPU where there is no GPU, bit for bit as the
 // default; cuda without the CUDA backend is refused before anything is read or written, saying why.
 TEST(CliTrain, BackendAutoIsTheCpuWithoutAGpuAndCudaIsRefused) {

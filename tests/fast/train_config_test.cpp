@@ -675,3 +675,43 @@ TEST(TrainConfigValidate, AcceptsTheAllowedEdgeCases) {
 
 }  // namespace
 }  // namespace lumigauss
+
+namespace lumigauss {
+namespace {
+
+// `train --preset fast --iterations 300` kept the stage boundaries at 1500/1600: the whole run was the
+// unshadowed stage, its shadowed renders nearly black (eval: 10.0 dB shadowed on plaza_mini, 12.8 now).
+TEST(TrainConfigSchedule, IterationsScaleTheStagesAndWindowsNotTheRhythms) {
+    TrainConfig c = train_preset("fast");
+    scale_schedule(c, 300);
+    EXPECT_EQ(c.iterations, 300);
+    EXPECT_EQ(c.warmup, 150);
+    EXPECT_EQ(c.start_shadowed, 160);
+    EXPECT_EQ(c.start_regularization, 50);
+    EXPECT_EQ(c.lr_position_max_steps, 225);
+    EXPECT_EQ(c.densify_from, 10);
+    EXPECT_EQ(c.densify_until, 120);
+    EXPECT_EQ(c.background_alpha_from, 10);
+    EXPECT_EQ(c.densify_interval, 100);          // rhythms of photo visits: unchanged
+    EXPECT_EQ(c.opacity_reset_interval, 600);
+    EXPECT_EQ(c.checkpoint_interval, train_preset("fast").checkpoint_interval);
+    EXPECT_NO_THROW(validate_train_config(c));
+    EXPECT_EQ(schedule_summary(c),
+              "stages: unshadowed 1-149, transfer fitting 150-160, shadowed 161-300; densification 10-120 every "
+              "100, opacity reset every 600");
+
+    // Tiny runs keep one transfer-fitting iteration and the stage order; longer ones stretch.
+    TrainConfig tiny = train_preset("default");
+    scale_schedule(tiny, 10);
+    EXPECT_EQ(tiny.warmup, 5);
+    EXPECT_EQ(tiny.start_shadowed, 6);
+    TrainConfig longer = train_preset("fast");
+    scale_schedule(longer, 30000);
+    EXPECT_EQ(longer.warmup, 15000);
+    EXPECT_EQ(longer.start_shadowed, 16000);
+    EXPECT_EQ(longer.densify_until, 12000);
+    EXPECT_THROW(scale_schedule(longer, 0), Error);
+}
+
+}  // namespace
+}  // namespace lumigauss

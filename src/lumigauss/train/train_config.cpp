@@ -405,6 +405,36 @@ TrainConfig train_preset(std::string_view name) {
                 "' (valid presets: default, fast, paper, paper-fast)");
 }
 
+void scale_schedule(TrainConfig& c, std::int64_t iterations) {
+    if (iterations < 1) throw Error("--iterations must be at least 1, got " + std::to_string(iterations));
+    const double ratio = double(iterations) / double(std::max<std::int64_t>(c.iterations, 1));
+    const auto scaled = [&](std::int64_t v) { return std::int64_t(std::llround(double(v) * ratio)); };
+    const std::int64_t fitting = c.start_shadowed - c.warmup;  // the transfer-fitting stage's length
+    c.iterations = iterations;
+    c.warmup = scaled(c.warmup);
+    c.start_shadowed = c.warmup + (fitting > 0 ? std::max<std::int64_t>(1, scaled(fitting)) : fitting);
+    c.start_regularization = scaled(c.start_regularization);
+    c.lr_position_max_steps = std::max<std::int64_t>(1, scaled(c.lr_position_max_steps));
+    c.densify_from = scaled(c.densify_from);
+    c.densify_until = scaled(c.densify_until);
+    // densify_interval and opacity_reset_interval stay: they are rhythms of visits to the photos, not fractions
+    // of the run. Scaled with a short run, a reset every 60 iterations with a prune 10 later left no surfel
+    // able to climb back over min_opacity (a 300-iteration fast run ended with 0 surfels).
+    c.background_alpha_from = scaled(c.background_alpha_from);
+}
+
+std::string schedule_summary(const TrainConfig& c) {
+    // stage_of (trainer.cpp): unshadowed below warmup, transfer fitting up to start_shadowed, then shadowed.
+    const auto n = [](std::int64_t v) { return std::to_string(v); };
+    std::string s = "stages: unshadowed 1-" + n(std::min(c.warmup - 1, c.iterations));
+    if (c.iterations >= c.warmup)
+        s += ", transfer fitting " + n(c.warmup) + "-" + n(std::min(c.start_shadowed, c.iterations));
+    if (c.iterations > c.start_shadowed) s += ", shadowed " + n(c.start_shadowed + 1) + "-" + n(c.iterations);
+    s += "; densification " + n(c.densify_from) + "-" + n(c.densify_until) + " every " +
+         n(c.densify_interval) + ", opacity reset every " + n(c.opacity_reset_interval);
+    return s;
+}
+
 std::string train_config_to_json(const TrainConfig& config) {
     Json j = Json::object();
     for (const Field& f : kFields) {

@@ -63,9 +63,10 @@ struct TrainConfig {
     double densify_grad_threshold = 0.0002;
     double min_opacity = 0.05;
     // A reset sets every opacity to at most this. The official 0.01 is below min_opacity: a surfel that fewer
-    // than about a third of the photos see cannot climb back over min_opacity before the next prune (Adam moves
-    // the logit about lr_opacity per visit), so the reset itself deletes weakly observed surfaces. Above
-    // min_opacity (3DGS's ratio: reset 0.01, prune 0.005) only surfels that the photos push down are pruned.
+    // than about a third of the photos see cannot climb back over min_opacity before the next prune (Adam
+    // moves the logit about lr_opacity per visit), so the reset itself deletes weakly observed surfaces.
+    // Above min_opacity (3DGS's ratio: reset 0.01, prune 0.005) only surfels that the photos push down are
+    // pruned.
     double opacity_reset_value = 0.01;
     double max_screen_size = 20.0;  // pixels; applied after the first opacity reset
     double percent_dense = 0.01;
@@ -130,6 +131,17 @@ void apply_train_config_json(TrainConfig& config, std::string_view json_text, st
 // Applies "key=value" (value parsed as the field's type; bools accept true/false/1/0). Throws Error naming
 // the key for unknown keys or unparsable values.
 void apply_train_config_override(TrainConfig& config, std::string_view key_equals_value);
+
+// A run of `iterations` on the config's schedule (as gsplat's steps_scaler): the stage boundaries, the
+// regularisation start, the position LR decay, the densification window and the background-alpha start are
+// multiplied by iterations / config.iterations, so that a short run still passes through all three stages
+// (the transfer-fitting stage keeps at least one iteration). The densification and opacity-reset intervals
+// stay (a rhythm of visits to the photos: scaled down, surfels could not recover from a reset before the next
+// prune), and so do the checkpoint and log intervals. Throws Error if iterations < 1.
+void scale_schedule(TrainConfig& config, std::int64_t iterations);
+
+// One line per phase: the stages and the densification window, as `train` prints them at the start.
+std::string schedule_summary(const TrainConfig& config);
 
 // Checks consistency (iterations > 0, warmup <= start_shadowed, sample counts > 0, non-negative weights and
 // rates, downscale in {1, 2, 4, 8}, ...); throws Error naming the offending key.
