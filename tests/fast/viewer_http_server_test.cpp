@@ -4,6 +4,7 @@
 #include <arpa/inet.h>
 #include <ifaddrs.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -11,6 +12,7 @@
 
 #include <atomic>
 #include <cctype>
+#include <chrono>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -88,7 +90,7 @@ std::string get(const std::string& target, int port, const std::string& method =
 // A server with a small model in a thread, for the duration of a test.
 class ViewServerTest : public ::testing::Test {
   protected:
-    void start(ViewerSiteOptions options = {}, std::size_t max_request = 16384) {
+    void start(ViewerSiteOptions options = {}, std::size_t max_request = 16384, int head_seconds = 10) {
         const Camera cam = testing::test_camera();
         TrainedRun run =
             relight_test::in_memory_run(relight_test::random_model(cam, 3, 25), {"a.png", "b.png"});
@@ -97,6 +99,7 @@ class ViewServerTest : public ::testing::Test {
         site_ = std::make_unique<ViewerSite>(payload_, scene_, std::move(options));
         HttpServerOptions so;
         so.max_request_bytes = max_request;
+        so.head_seconds = head_seconds;
         server_ = std::make_unique<HttpServer>(so, [this](const HttpRequest& r) { return site_->handle(r); });
         thread_ = std::thread([this] { server_->run(); });
     }
@@ -130,6 +133,44 @@ std::string proc_listen_address(int port) {
             return local.substr(0, local.size() - 5);
     }
     return "";
+}
+
+// 70 idle sockets (64 threads, each waiting 10 s for a head) made a normal GET / fail; now a new client takes
+// the place of the oldest connection still waiting for its head.
+TEST_F(ViewServerTest, IdleConnectionsDoNotStarveANewClient) {
+    start();
+    std::vector<int> idle;
+    for (int i = 0; i < 70; ++i) idle.push_back(connect_to(htonl(INADDR_LOOPBACK), port()));
+    const auto t0 = std::chrono::steady_clock::now();
+    EXPECT_EQ(fetch("/").status, 200);
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(5));
+    for (const int fd : idle)
+        if (fd >= 0) ::close(fd);
+}
+
+// A client trickling its head (a byte every 200 ms) held its thread as long as it liked: the head now has a
+// deadline from the connection (1 s here), after which the server closes without answering.
+TEST_F(ViewServerTest, ASlowHeadIsCutAtItsDeadline) {
+    start({}, 16384, 1);
+    const int fd = connect_to(htonl(INADDR_LOOPBACK), port());
+    ASSERT_GE(fd, 0);
+    const std::string head = get("/", port());
+    const auto t0 = std::chrono::steady_clock::now();
+    bool closed = false;
+    for (std::size_t i = 0; i + 1 < head.size() && !closed; ++i) {
+        if (::send(fd, &head[i], 1, MSG_NOSIGNAL) != 1) closed = true;
+        pollfd p{fd, POLLIN, 0};
+        if (::poll(&p, 1, 200) > 0) {
+            char c;
+            closed = ::recv(fd, &c, 1, 0) <= 0;
+        }
+    }
+    EXPECT_TRUE(closed) << "the server waited for the whole slow head";
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_GT(seconds, 0.8);
+    EXPECT_LT(seconds, 4.0);
+    ::close(fd);
+    EXPECT_EQ(fetch("/").status, 200);  // and the server goes on serving
 }
 
 TEST_F(ViewServerTest, ViewListensOnLoopbackOnly) {

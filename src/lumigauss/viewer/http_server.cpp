@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <string>
 
@@ -90,11 +91,20 @@ int bound_port(int fd) {
 
 enum class Received { Head, Malformed, TooLarge, Gone };
 
-// Reads until the request head is complete, malformed or longer than max_bytes (or the client is gone).
-Received receive_head(int fd, std::size_t max_bytes, HttpRequest& request) {
+// Reads until the request head is complete, malformed or longer than max_bytes, or the client is gone or
+// past the deadline (a client trickling a header line every few seconds used to hold its thread forever).
+Received receive_head(int fd, std::size_t max_bytes, std::chrono::steady_clock::time_point deadline,
+                      HttpRequest& request) {
     std::string data;
     char buf[8192];
     for (;;) {
+        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+            deadline - std::chrono::steady_clock::now());
+        if (left.count() <= 0) return Received::Gone;
+        pollfd p{fd, POLLIN, 0};
+        const int ready = ::poll(&p, 1, int(left.count()));
+        if (ready < 0 && errno == EINTR) continue;
+        if (ready <= 0) return Received::Gone;
         const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
         if (n < 0 && errno == EINTR) continue;
         if (n <= 0) return Received::Gone;
@@ -174,23 +184,46 @@ void HttpServer::run() {
         const int fd = ::accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
         if (fd < 0) continue;  // the client gave up already, or a transient shortage: keep serving
         if (workers_.size() >= std::size_t(kMaxConnections)) {
-            ::close(fd);
-            continue;
+            evict_oldest_waiting();
+            reap_finished(false);
+            // Every connection busy with a response: a real overload, the new client is turned away.
+            if (workers_.size() >= std::size_t(kMaxConnections) + 8) {
+                ::close(fd);
+                continue;
+            }
         }
         Worker& w = workers_.emplace_back();
+        w.fd = fd;
         w.thread = std::thread([this, fd, &w] {
-            serve_connection(fd);
+            serve_connection(fd, w);
             w.done.store(true);
         });
     }
     reap_finished(true);
 }
 
-void HttpServer::serve_connection(int fd) {
+// The oldest connection still waiting for its request head gives its place to a new client: shutting its
+// socket down ends its recv at once, and its thread closes it. Workers are in accept order.
+void HttpServer::evict_oldest_waiting() {
+    const std::lock_guard<std::mutex> lock(waiting_mutex_);
+    for (Worker& w : workers_)
+        if (w.awaiting_head && !w.done.load()) {
+            ::shutdown(w.fd, SHUT_RDWR);
+            w.awaiting_head = false;
+            return;
+        }
+}
+
+void HttpServer::serve_connection(int fd, Worker& worker) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(options_.head_seconds);
     set_timeouts(fd);
     HttpRequest request;
-    const Received got = receive_head(fd, options_.max_request_bytes, request);
-    if (got == Received::Gone) {  // closed, timed out or failed before a whole head arrived
+    const Received got = receive_head(fd, options_.max_request_bytes, deadline, request);
+    {
+        const std::lock_guard<std::mutex> lock(waiting_mutex_);  // from here on nobody shuts fd down
+        worker.awaiting_head = false;
+    }
+    if (got == Received::Gone) {  // closed, timed out, evicted or failed before a whole head arrived
         ::close(fd);
         return;
     }

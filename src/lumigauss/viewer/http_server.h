@@ -11,11 +11,15 @@
 //       or localhost, any port (DNS rebinding: a web page elsewhere whose name resolves to 127.0.0.1 must
 //       not read the model; an SSH tunnel to another local port must still work);
 //   431 a head longer than max_request_bytes.
-// A connection idle for 10 s is closed; at most 64 run at once (more are closed unanswered).
+// A client has head_seconds (10) from its connection to send the whole request head, however it trickles in.
+// At most 64 connections run at once; a new client past that takes the place of the oldest connection that is
+// still waiting for its head, so idle or slow clients cannot starve a real one (only 64 connections all busy
+// sending responses make a new one wait, closed unanswered).
 #include <atomic>
 #include <cstddef>
 #include <functional>
 #include <list>
+#include <mutex>
 #include <thread>
 
 #include "lumigauss/viewer/http_message.h"
@@ -27,6 +31,7 @@ using HttpHandler = std::function<HttpResponse(const HttpRequest&)>;
 struct HttpServerOptions {
     int port = 0;                           // 0: the system picks a free port
     std::size_t max_request_bytes = 16384;  // request line + headers
+    int head_seconds = 10;                  // from accept to the end of the request head
 };
 
 class HttpServer {
@@ -46,7 +51,9 @@ class HttpServer {
     void stop() noexcept;
 
   private:
-    void serve_connection(int fd);
+    struct Worker;
+    void serve_connection(int fd, Worker& worker);
+    void evict_oldest_waiting();
     HttpResponse respond(const HttpRequest& request) const;
     void reap_finished(bool all);
 
@@ -59,8 +66,11 @@ class HttpServer {
     struct Worker {
         std::thread thread;
         std::atomic<bool> done{false};
+        int fd = -1;
+        bool awaiting_head = true;  // guarded by waiting_mutex_: while true, fd is open and may be shut down
     };
-    std::list<Worker> workers_;  // touched by the run() thread only
+    std::list<Worker> workers_;  // the list is touched by the run() thread only
+    std::mutex waiting_mutex_;
 };
 
 }  // namespace lumigauss::view
