@@ -422,7 +422,8 @@ TEST(TrainConfigJson, NotJsonOrNotAnObject) {
                 AllOf(HasSubstr("run/config.json"), HasSubstr("not valid JSON")));
     EXPECT_THAT(json_error(""), AllOf(HasSubstr("run/config.json"), HasSubstr("not valid JSON")));
     EXPECT_THAT(json_error("{\"iterations\": 10} trailing"), HasSubstr("not valid JSON"));
-    // A number out of double's range was an internal error (nlohmann's out_of_range), found by fuzz_train_config.
+    // A number out of double's range was an internal error (nlohmann's out_of_range), found by
+    // fuzz_train_config.
     EXPECT_THAT(json_error("{\"lambda_shadow\": 1e400}"),
                 AllOf(HasSubstr("run/config.json"), HasSubstr("not valid JSON")));
     for (const char* text : {"[1, 2]", "42", "\"paper\"", "null"}) {
@@ -592,6 +593,8 @@ TEST(TrainConfigValidate, RejectsEachBadValueNamingTheKey) {
         {"downscale", [](TrainConfig& c) { c.downscale = 16; }},
         {"transfer_samples", [](TrainConfig& c) { c.transfer_samples = 0; }},
         {"env_samples", [](TrainConfig& c) { c.env_samples = -2; }},
+        {"transfer_samples", [](TrainConfig& c) { c.transfer_samples = 100000; }},  // ran for hours
+        {"env_samples", [](TrainConfig& c) { c.env_samples = 5000; }},
         {"lambda_dssim", [](TrainConfig& c) { c.lambda_dssim = -0.1; }},
         {"lambda_unshadowed_stage3", [](TrainConfig& c) { c.lambda_unshadowed_stage3 = -1e-9; }},
         {"lambda_range01", [](TrainConfig& c) { c.lambda_range01 = -1; }},
@@ -692,13 +695,14 @@ TEST(TrainConfigSchedule, IterationsScaleTheStagesAndWindowsNotTheRhythms) {
     EXPECT_EQ(c.densify_from, 10);
     EXPECT_EQ(c.densify_until, 120);
     EXPECT_EQ(c.background_alpha_from, 10);
-    EXPECT_EQ(c.densify_interval, 100);          // rhythms of photo visits: unchanged
+    EXPECT_EQ(c.densify_interval, 100);  // rhythms of photo visits: unchanged
     EXPECT_EQ(c.opacity_reset_interval, 600);
     EXPECT_EQ(c.checkpoint_interval, train_preset("fast").checkpoint_interval);
     EXPECT_NO_THROW(validate_train_config(c));
-    EXPECT_EQ(schedule_summary(c),
-              "stages: unshadowed 1-149, transfer fitting 150-160, shadowed 161-300; densification 10-120 every "
-              "100, opacity reset every 600");
+    EXPECT_EQ(
+        schedule_summary(c),
+        "stages: unshadowed 1-149, transfer fitting 150-160, shadowed 161-300; densification 10-120 every "
+        "100, opacity reset every 600");
 
     // Tiny runs keep one transfer-fitting iteration and the stage order; longer ones stretch.
     TrainConfig tiny = train_preset("default");

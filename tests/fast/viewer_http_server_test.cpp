@@ -287,6 +287,8 @@ TEST_F(ViewServerTest, ViewRejectsMalformedForeignAndOversizedRequests) {
     EXPECT_EQ(exchange(port(), "GET / HTTP/1.1\nHost: x\n\n").status, 400);
     EXPECT_EQ(exchange(port(), "GET / HTTP/2.0\r\n\r\n").status, 400);
     EXPECT_EQ(exchange(port(), "GET / HTTP/1.1\r\n\r\n").status, 400) << "HTTP/1.1 needs a Host";
+    EXPECT_EQ(exchange(port(), "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nHost: evil.example\r\n\r\n").status, 400)
+        << "a second Host header";
     EXPECT_EQ(exchange(port(), "GET / HTTP/1.1\r\nHost: evil.example:" + std::to_string(port()) + "\r\n\r\n")
                   .status,
               400)

@@ -30,7 +30,12 @@ std::string step_log_line(const StepReport& r, double elapsed_seconds) {
     j["background_alpha"] = r.background_alpha;
     j["opacity"] = r.opacity;
     j["sky_residual"] = r.sky_residual;
-    j["psnr"] = r.psnr;
+    // The transfer-fitting stage renders no photo: null, not 0, so that plots of the log show a gap, not a
+    // dip.
+    if (r.stage == Stage::TransferFitting)
+        j["psnr"] = nullptr;
+    else
+        j["psnr"] = r.psnr;
     j["surfels"] = r.surfels;
     if (r.densify_ran) {
         j["cloned"] = r.densified.cloned;

@@ -417,9 +417,9 @@ void scale_schedule(TrainConfig& c, std::int64_t iterations) {
     c.lr_position_max_steps = std::max<std::int64_t>(1, scaled(c.lr_position_max_steps));
     c.densify_from = scaled(c.densify_from);
     c.densify_until = scaled(c.densify_until);
-    // densify_interval and opacity_reset_interval stay: they are rhythms of visits to the photos, not fractions
-    // of the run. Scaled with a short run, a reset every 60 iterations with a prune 10 later left no surfel
-    // able to climb back over min_opacity (a 300-iteration fast run ended with 0 surfels).
+    // densify_interval and opacity_reset_interval stay: they are rhythms of visits to the photos, not
+    // fractions of the run. Scaled with a short run, a reset every 60 iterations with a prune 10 later left
+    // no surfel able to climb back over min_opacity (a 300-iteration fast run ended with 0 surfels).
     c.background_alpha_from = scaled(c.background_alpha_from);
 }
 
@@ -523,8 +523,12 @@ void validate_train_config(const TrainConfig& c) {
         {"env_noise_sigma", c.env_noise_sigma},
     }};
     for (const auto& [key, value] : non_negative) require(value >= 0.0, key, value, "must be >= 0");
-    require(c.transfer_samples > 0, "transfer_samples", c.transfer_samples, "must be > 0");
-    require(c.env_samples > 0, "env_samples", c.env_samples, "must be > 0");
+    // Bounded above too: each costs per surfel (or per photo) per iteration, and one absurd value ran for
+    // hours.
+    require(c.transfer_samples > 0 && c.transfer_samples <= 1024, "transfer_samples", c.transfer_samples,
+            "must be in 1..1024 (official 25)");
+    require(c.env_samples > 0 && c.env_samples <= 1024, "env_samples", c.env_samples,
+            "must be in 1..1024 (official 10)");
 
     // Learning rates. The position schedule is log-linear: both ends > 0, or both 0 (frozen positions).
     require(c.lr_position_init >= 0.0, "lr_position_init", c.lr_position_init, "must be >= 0");

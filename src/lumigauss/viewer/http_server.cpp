@@ -245,6 +245,10 @@ HttpResponse HttpServer::respond(const HttpRequest& request) const {
     const auto length = request.header("content-length");
     if (request.header("transfer-encoding") || (length && *length != "0"))
         return HttpResponse::text(400, "this server takes no request bodies\n");
+    // One Host header only: with two, a proxy and this server could each read a different one.
+    const auto hosts = std::count_if(request.headers.begin(), request.headers.end(),
+                                     [](const auto& h) { return h.first == "host"; });
+    if (hosts > 1) return HttpResponse::text(400, "several Host headers\n");
     const auto host = request.header("host");
     if (host ? !host_allowed(*host) : request.version != "HTTP/1.0")
         return HttpResponse::text(400, "unexpected Host header\n");
