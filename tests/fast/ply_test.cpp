@@ -72,6 +72,17 @@ TEST(Ply, ErrorsNameTheFileAndTheProblem) {
     write_text(dir / "trunc.ply",
                "ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty float x\nend_header\nabcd");
     expect_error([&] { read_ply_vertices(dir / "trunc.ply"); }, {"trunc.ply", "truncated"});
+    // A property declared twice (which column is meant?) and binary data past the declared records (a count
+    // that undercounts the file) were read silently.
+    write_text(dir / "twice.ply",
+               "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float x\n"
+               "end_header\nabcdabcd");
+    expect_error([&] { read_ply_vertices(dir / "twice.ply"); }, {"twice.ply", "'x'", "declared twice"});
+    write_text(dir / "more.ply",
+               "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nend_header\n"
+               "\x01\x02\x03\x04\x05\x06\x07\x08");
+    expect_error([&] { read_ply_vertices(dir / "more.ply"); },
+                 {"more.ply", "after the last declared record"});
     // A tiny file declaring a huge count fails before anything is allocated for it (it used to ask for 4 TB
     // per column and end in std::bad_alloc, or the OOM killer for smaller counts).
     write_text(dir / "huge.ply",

@@ -113,6 +113,10 @@ PlyHeader parse_header(std::istream& in, const std::string& path) {
             if (!ls) fail_in_file(path, where + "malformed property line '" + line + "'");
             type_size(p.type, path);
             if (!p.list_size.empty()) type_size(p.list_size, path);
+            for (const PlyProperty& other : h.elements.back().properties)
+                if (other.name == p.name)  // which of the two columns would a reader take?
+                    fail_in_file(path, where + "property '" + p.name + "' of element '" +
+                                           h.elements.back().name + "' is declared twice");
             h.elements.back().properties.push_back(p);
         } else if (word != "comment" && word != "obj_info" && !word.empty()) {
             fail_in_file(path, where + "unexpected '" + word + "'");
@@ -244,6 +248,10 @@ PlyVertexTable read_ply_vertices(const std::string& path) {
             read_element_binary(in, e, swap, target, path);
     }
     if (!found) fail_in_file(path, "PLY file has no 'vertex' element");
+    // Binary data past the last declared record: the counts undercount what the file holds (a wrong count, or
+    // two files joined), so what was read may not be what was meant.
+    if (h.format != PlyFormat::Ascii && in.peek() != std::ifstream::traits_type::eof())
+        fail_in_file(path, "data after the last declared record (a wrong element count?)");
     for (std::size_t k = 0; k < table.names.size(); ++k)
         for (std::size_t i = 0; i < table.count; ++i)
             if (!std::isfinite(table.columns[k][i]))
