@@ -16,7 +16,10 @@ done
 jobs=$(nproc)
 
 scripts/setup.sh --no-build
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DLUMIGAUSS_WERROR=ON ${LUMIGAUSS_CMAKE_ARGS:-}
+slow=OFF
+[ $all -eq 1 ] && slow=ON
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DLUMIGAUSS_WERROR=ON -DLUMIGAUSS_BUILD_SLOW_TESTS=$slow \
+      ${LUMIGAUSS_CMAKE_ARGS:-}
 cmake --build build -j "$jobs"
 labels="fast"
 [ $all -eq 1 ] && labels="fast|slow"
