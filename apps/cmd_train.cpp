@@ -143,7 +143,7 @@ int run_train(const TrainFlags& f) {
     if (run.far_points_dropped() > 0)
         std::printf(
             "train: dropped %zu SfM point(s) more than %.4g from the cameras' centre (1000x their "
-            "radius: failed triangulations)\n",
+            "extent: failed triangulations)\n",
             run.far_points_dropped(), run.far_point_limit());
     std::fflush(stdout);
     if (request.backend != RasterBackend::Cpu && !f.quiet)

@@ -1,5 +1,7 @@
 #include "sample_files.h"
 
+#include "fuzz_support.h"
+
 #include <filesystem>
 #include <vector>
 
@@ -32,6 +34,33 @@ SurfelModel sample_surfel_model() {
 
 void make_folder(const std::string& dir) {
     std::filesystem::create_directories(dir);
+}
+
+namespace {
+
+std::vector<std::string> colmap_files(const std::string& extension) {
+    return {"cameras" + extension, "images" + extension, "points3D" + extension};
+}
+
+}  // namespace
+
+std::string colmap_seed(const std::string& extension) {
+    const std::string dir = scratch_path("seed_colmap" + extension);
+    if (extension == ".txt")
+        write_colmap_text(dir, sample_colmap_model());
+    else
+        write_colmap_binary(dir, sample_colmap_model());
+    std::vector<std::string> parts;
+    for (const std::string& f : colmap_files(extension)) parts.push_back(read_file(dir + "/" + f));
+    return join_parts(parts);
+}
+
+void parse_colmap_parts(Bytes input, const std::string& extension) {
+    const std::string dir = scratch_path("colmap" + extension);
+    make_folder(dir);
+    const std::vector<std::string> files = colmap_files(extension), parts = split_parts(input, files.size());
+    for (std::size_t i = 0; i < files.size(); ++i) write_file(dir + "/" + files[i], parts[i]);
+    refuse_cleanly([&] { (void)(extension == ".txt" ? read_colmap_text(dir) : read_colmap_binary(dir)); });
 }
 
 }  // namespace lumigauss::fuzz

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "lumigauss/io/dataset_detail.h"
+#include "lumigauss/io/scene_extent.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {
@@ -108,17 +109,14 @@ std::vector<const View*> Dataset::split(Split which) const {
 
 namespace {
 
-// Drops the SfM points farther than kFarPointRadii x the cameras' radius from their centroid (a point at 1e20
-// from a bad triangulation overflowed the initial surfel scale at iteration 1).
+// Drops the SfM points farther than kFarPointRadii x the cameras' extent (scene_extent.h) from their centroid
+// (a point at 1e20 from a bad triangulation overflowed the initial surfel scale at iteration 1).
 void drop_far_points(Dataset& d) {
     if (d.views.empty() || d.point_xyz.empty()) return;
-    Vec3d centroid{};
-    for (const View& v : d.views) centroid = centroid + v.camera.center();
-    centroid = (1.0 / double(d.views.size())) * centroid;
-    double radius = 0;
-    for (const View& v : d.views) radius = std::max(radius, length(v.camera.center() - centroid));
-    if (!(radius > 0)) return;  // one camera (or all at one place): no scale to judge by
-    d.far_point_limit = kFarPointRadii * radius;
+    const CameraExtent cameras = camera_extent(d.views);
+    if (!(cameras.radius > 0)) return;  // one camera (or all at one place): no scale to judge by
+    d.far_point_limit = kFarPointRadii * cameras.radius;
+    const Vec3d centroid = cameras.center;
     std::size_t kept = 0;
     for (std::size_t i = 0; i < d.point_xyz.size(); ++i) {
         const Vec3f& p = d.point_xyz[i];

@@ -54,7 +54,8 @@ struct Dataset {
     std::vector<Vec3f> point_xyz, point_rgb;  // SfM points (rgb in 0..1); empty for NeRF-OSR
     int downscale = 1;
     // SfM points dropped at load for lying absurdly far from the cameras (kFarPointRadii x the cameras'
-    // radius about their centroid): one point at 1e20 made the initial surfel scale overflow.
+    // extent about their centroid, io/scene_extent.h): one point at 1e20 made the initial surfel scale
+    // overflow.
     std::size_t far_points_dropped = 0;
     double far_point_limit = 0;  // the distance from the cameras' centroid beyond which they were dropped
 
