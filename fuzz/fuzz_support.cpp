@@ -29,6 +29,31 @@ struct ScratchFolder {
 
 }  // namespace
 
+namespace {
+
+// A function-local static: registration runs from other files' static initialisers, in any order.
+std::vector<FuzzTarget>& target_list() {
+    static std::vector<FuzzTarget> targets;
+    return targets;
+}
+
+}  // namespace
+
+bool register_target(const FuzzTarget& target) {
+    target_list().push_back(target);
+    return true;
+}
+
+const std::vector<FuzzTarget>& registered_targets() {
+    return target_list();
+}
+
+const FuzzTarget* find_target(const std::string& name) {
+    for (const FuzzTarget& t : target_list())
+        if (name == t.name) return &t;
+    return nullptr;
+}
+
 std::string scratch_path(const std::string& name) {
     static ScratchFolder folder;
     return (folder.path / name).string();

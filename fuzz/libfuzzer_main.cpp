@@ -7,6 +7,15 @@
 
 #include "fuzz_support.h"
 
+namespace {
+
+// The executable links exactly one file of targets/.
+const lumigauss::fuzz::FuzzTarget& fuzz_target() {
+    return lumigauss::fuzz::registered_targets().at(0);
+}
+
+}  // namespace
+
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
     using namespace lumigauss::fuzz;
     if (const char* dir = std::getenv("LUMIGAUSS_FUZZ_WRITE_SEEDS")) {
@@ -21,6 +30,6 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-    lumigauss::fuzz::fuzz_target().parse({data, size});
+    fuzz_target().parse({data, size});
     return 0;
 }

@@ -1,8 +1,9 @@
-// The fuzz targets without libFuzzer (any compiler): the target's seeds, any files given, and then seeded
+// The fuzz targets without libFuzzer (any compiler): a target's seeds, any files given, and then seeded
 // random mutations of them, each parsed once. CTest runs every target this way on each build, so the
 // ASan/UBSan suite fuzzes too; scripts/fuzz.sh runs the coverage-guided libFuzzer build for longer.
 //
-//   fuzz_NAME [--mutations N] [--seed S] [FILE|DIR ...]
+//   lumigauss_fuzz TARGET [--mutations N] [--seed S] [FILE|DIR ...]
+//   lumigauss_fuzz --list
 //
 // Each input is written to NAME.last-input before it is parsed: after a crash, that file reproduces it.
 // Memory is capped (an allocation a tiny input should never need fails, and the target with it), and each
@@ -107,10 +108,10 @@ void mutate_once(std::string& s, Random& r) {
     }
 }
 
-void parse_one(const std::string& input, const std::string& keep_path) {
+void parse_one(const FuzzTarget& target, const std::string& input, const std::string& keep_path) {
     write_file(keep_path, input);
     ::alarm(10);
-    fuzz_target().parse({reinterpret_cast<const std::uint8_t*>(input.data()), input.size()});
+    target.parse({reinterpret_cast<const std::uint8_t*>(input.data()), input.size()});
     ::alarm(0);
 }
 
@@ -121,11 +122,22 @@ int main(int argc, char** argv) {
     const rlimit cap{4ull << 30, 4ull << 30};  // address space: std::bad_alloc past it
     ::setrlimit(RLIMIT_AS, &cap);
 #endif
-    const FuzzTarget& target = fuzz_target();
+    if (argc < 2 || std::string(argv[1]) == "--list") {
+        std::printf("usage: lumigauss_fuzz TARGET [--mutations N] [--seed S] [FILE|DIR ...]\ntargets:");
+        for (const FuzzTarget& t : registered_targets()) std::printf(" %s", t.name);
+        std::printf("\n");
+        return argc < 2 ? 2 : 0;
+    }
+    const FuzzTarget* found = find_target(argv[1]);
+    if (found == nullptr) {
+        std::fprintf(stderr, "lumigauss_fuzz: no target named %s (--list names them)\n", argv[1]);
+        return 2;
+    }
+    const FuzzTarget& target = *found;
     long mutations = 2000;
     std::uint64_t seed = 1;
     std::vector<std::string> inputs = target.seeds();
-    for (int i = 1; i < argc; ++i) {
+    for (int i = 2; i < argc; ++i) {
         const std::string a = argv[i];
         if ((a == "--mutations" || a == "--seed") && i + 1 < argc) {
             const std::string v = argv[++i];
@@ -141,21 +153,21 @@ int main(int argc, char** argv) {
         }
     }
     const std::string keep = std::string(target.name) + ".last-input";
-    std::printf("fuzz_%s: %zu inputs, %ld mutations (seed %llu); a crash leaves its input in %s\n",
-                target.name, inputs.size(), mutations, static_cast<unsigned long long>(seed), keep.c_str());
+    std::printf("%s: %zu inputs, %ld mutations (seed %llu); a crash leaves its input in %s\n", target.name,
+                inputs.size(), mutations, static_cast<unsigned long long>(seed), keep.c_str());
     std::fflush(stdout);
     const auto t0 = std::chrono::steady_clock::now();
-    for (const std::string& input : inputs) parse_one(input, keep);
+    for (const std::string& input : inputs) parse_one(target, input, keep);
     Random random{seed * 0x9E3779B97F4A7C15ULL + 1};
     for (long m = 0; m < mutations; ++m) {
         std::string input = inputs[random.below(inputs.size())];
         const std::size_t edits = 1 + random.below(4);
         for (std::size_t e = 0; e < edits; ++e) mutate_once(input, random);
-        parse_one(input, keep);
+        parse_one(target, input, keep);
     }
     std::filesystem::remove(keep);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("fuzz_%s: %zu inputs parsed in %.1f s, no finding\n", target.name,
+    std::printf("%s: %zu inputs parsed in %.1f s, no finding\n", target.name,
                 inputs.size() + std::size_t(mutations), s);
     return 0;
 }

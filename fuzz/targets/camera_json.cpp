@@ -22,9 +22,6 @@ void parse(Bytes input) {
 
 }  // namespace
 
-const FuzzTarget& fuzz_target() {
-    static const FuzzTarget target{"camera_json", seeds, parse};
-    return target;
-}
+LUMIGAUSS_FUZZ_TARGET(camera_json, seeds, parse)
 
 }  // namespace lumigauss::fuzz

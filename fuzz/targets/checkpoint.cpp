@@ -29,9 +29,6 @@ void parse(Bytes input) {
 
 }  // namespace
 
-const FuzzTarget& fuzz_target() {
-    static const FuzzTarget target{"checkpoint", seeds, parse};
-    return target;
-}
+LUMIGAUSS_FUZZ_TARGET(checkpoint, seeds, parse)
 
 }  // namespace lumigauss::fuzz

@@ -14,9 +14,6 @@ void parse(Bytes input) {
 
 }  // namespace
 
-const FuzzTarget& fuzz_target() {
-    static const FuzzTarget target{"colmap_text", seeds, parse};
-    return target;
-}
+LUMIGAUSS_FUZZ_TARGET(colmap_text, seeds, parse)
 
 }  // namespace lumigauss::fuzz

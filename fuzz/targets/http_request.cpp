@@ -31,9 +31,6 @@ void parse(Bytes input) {
 
 }  // namespace
 
-const FuzzTarget& fuzz_target() {
-    static const FuzzTarget target{"http_request", seeds, parse};
-    return target;
-}
+LUMIGAUSS_FUZZ_TARGET(http_request, seeds, parse)
 
 }  // namespace lumigauss::fuzz

@@ -43,9 +43,6 @@ void parse(Bytes input) {
 
 }  // namespace
 
-const FuzzTarget& fuzz_target() {
-    static const FuzzTarget target{"image", seeds, parse};
-    return target;
-}
+LUMIGAUSS_FUZZ_TARGET(image, seeds, parse)
 
 }  // namespace lumigauss::fuzz

@@ -31,9 +31,6 @@ void parse(Bytes input) {
 
 }  // namespace
 
-const FuzzTarget& fuzz_target() {
-    static const FuzzTarget target{"lighting_files", seeds, parse};
-    return target;
-}
+LUMIGAUSS_FUZZ_TARGET(lighting_files, seeds, parse)
 
 }  // namespace lumigauss::fuzz

@@ -33,9 +33,6 @@ void parse(Bytes input) {
 
 }  // namespace
 
-const FuzzTarget& fuzz_target() {
-    static const FuzzTarget target{"ply_vertices", seeds, parse};
-    return target;
-}
+LUMIGAUSS_FUZZ_TARGET(ply_vertices, seeds, parse)
 
 }  // namespace lumigauss::fuzz

@@ -20,9 +20,6 @@ void parse(Bytes input) {
 
 }  // namespace
 
-const FuzzTarget& fuzz_target() {
-    static const FuzzTarget target{"relightable_ply", seeds, parse};
-    return target;
-}
+LUMIGAUSS_FUZZ_TARGET(relightable_ply, seeds, parse)
 
 }  // namespace lumigauss::fuzz

@@ -21,9 +21,6 @@ void parse(Bytes input) {
 
 }  // namespace
 
-const FuzzTarget& fuzz_target() {
-    static const FuzzTarget target{"sh_text", seeds, parse};
-    return target;
-}
+LUMIGAUSS_FUZZ_TARGET(sh_text, seeds, parse)
 
 }  // namespace lumigauss::fuzz

@@ -26,9 +26,6 @@ void parse(Bytes input) {
 
 }  // namespace
 
-const FuzzTarget& fuzz_target() {
-    static const FuzzTarget target{"splat_ply", seeds, parse};
-    return target;
-}
+LUMIGAUSS_FUZZ_TARGET(splat_ply, seeds, parse)
 
 }  // namespace lumigauss::fuzz

@@ -17,9 +17,6 @@ void parse(Bytes input) {
 
 }  // namespace
 
-const FuzzTarget& fuzz_target() {
-    static const FuzzTarget target{"split_file", seeds, parse};
-    return target;
-}
+LUMIGAUSS_FUZZ_TARGET(split_file, seeds, parse)
 
 }  // namespace lumigauss::fuzz

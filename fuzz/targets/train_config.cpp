@@ -21,9 +21,6 @@ void parse(Bytes input) {
 
 }  // namespace
 
-const FuzzTarget& fuzz_target() {
-    static const FuzzTarget target{"train_config", seeds, parse};
-    return target;
-}
+LUMIGAUSS_FUZZ_TARGET(train_config, seeds, parse)
 
 }  // namespace lumigauss::fuzz

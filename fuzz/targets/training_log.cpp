@@ -19,9 +19,6 @@ void parse(Bytes input) {
 
 }  // namespace
 
-const FuzzTarget& fuzz_target() {
-    static const FuzzTarget target{"training_log", seeds, parse};
-    return target;
-}
+LUMIGAUSS_FUZZ_TARGET(training_log, seeds, parse)
 
 }  // namespace lumigauss::fuzz
