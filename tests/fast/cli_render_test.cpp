@@ -72,6 +72,19 @@ TEST(CliRender, BadModelGivesAnErrorNamingTheFile) {
     EXPECT_NE(rc, 0);
     const std::string log = test::read_text(dir / "log.txt");
     EXPECT_NE(log.find("bad.ply"), std::string::npos) << log;
+
+    // A model with no surfels rendered black images and exited 0.
+    test::write_text(dir / "empty.ply",
+                     "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
+                     "property float z\nend_header\n");
+    const std::string empty = std::string(LUMIGAUSS_BINARY) + " render --ply " + (dir / "empty.ply") +
+                              " --scene " + (dir / "scene") + " -o " + (dir / "out2") + " > " +
+                              (dir / "log2.txt") + " 2>&1";
+    EXPECT_NE(std::system(empty.c_str()), 0);
+    const std::string log2 = test::read_text(dir / "log2.txt");
+    EXPECT_NE(log2.find("empty.ply"), std::string::npos) << log2;
+    EXPECT_NE(log2.find("no surfels"), std::string::npos) << log2;
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / "out2")) << "a refused model wrote a folder";
 }
 
 // Without the CUDA backend (CI) `--backend cuda` is refused with the reason, and nothing is written; with it,

@@ -9,6 +9,7 @@
 #include "lumigauss/export/environment_files.h"
 #include "lumigauss/export/relightable_bundle.h"
 #include "lumigauss/io/image.h"
+#include "lumigauss/io/ply.h"
 #include "lumigauss/model/relightable_ply.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/shading/sh_text.h"
@@ -59,6 +60,18 @@ TEST(ExportBundle, RelightablePlyAndSidecarRoundTrip) {
         EXPECT_EQ(s.environments[i].name, run.image_names[i]);
         EXPECT_EQ(s.environments[i].index, int(i));
         expect_sh_equal(s.environments[i].sh, run.learned_sh(int(i)), 0.0);  // JSON keeps doubles exactly
+    }
+
+    // Every property, no surfel: refused, naming the file (it used to load as an empty model).
+    PlyVertexTable table = read_ply_vertices(ply), empty;
+    for (const std::string& name : table.names) empty.add(name, {});
+    write_ply_vertices(tmp / "out/empty.ply", empty);
+    try {
+        (void)load_relightable_ply(tmp / "out/empty.ply");
+        ADD_FAILURE() << "an empty model was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("empty.ply: the model has no surfels"), std::string::npos)
+            << e.what();
     }
 }
 

@@ -147,6 +147,17 @@ TEST(ColmapErrors, TruncatedBinary) {
     expect_error([&] { read_colmap_binary(tmp / "m"); }, {"points3D.bin", "truncated"});
 }
 
+// cameras.bin stores width and height as uint64: 2^32 + 40 was cast to int and read as 40.
+TEST(ColmapErrors, WrappedImageSizeInBinaryCameras) {
+    TempDir tmp;
+    write_colmap_binary(tmp / "m", test::small_model(3, 40, 30));
+    std::string cameras = test::read_text(tmp / "m/cameras.bin");
+    const std::uint64_t wrapped = (std::uint64_t(1) << 32) + 40;
+    std::memcpy(cameras.data() + 8 + 4 + 4, &wrapped, sizeof wrapped);  // count, id, model, then width
+    test::write_text(tmp / "m/cameras.bin", cameras);
+    expect_error([&] { read_colmap_binary(tmp / "m"); }, {"cameras.bin", "record 1 of", "width 4294967336"});
+}
+
 // A cut images.txt gave 5 of 10 views (the test views vanished) and a cut points3D.txt 81 of 219 points,
 // silently. COLMAP's "# Number of ..." header now says how many records there must be.
 TEST(ColmapErrors, TextCutAtALineBoundaryIsRefused) {

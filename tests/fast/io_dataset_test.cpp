@@ -10,6 +10,7 @@
 #include "fast/io_test_util.h"
 #include "lumigauss/io/colmap.h"
 #include "lumigauss/io/dataset.h"
+#include "lumigauss/io/ply.h"
 
 namespace lumigauss {
 namespace {
@@ -432,10 +433,35 @@ TEST(DatasetNerfOsr, Errors) {
     expect_error([&] { load_dataset(tmp.path().string()); }, {"a.txt", "found 15"});
     write_matrix((train / "pose" / "a.txt").string(), {2, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1});
     expect_error([&] { load_dataset(tmp.path().string()); }, {"a.txt", "orthonormal"});
+    write_matrix((train / "pose" / "a.txt").string(), {-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1});
+    expect_error([&] { load_dataset(tmp.path().string()); }, {"a.txt", "reflection"});
     write_matrix((train / "pose" / "a.txt").string(), test_c2w());
     test::write_text((train / "intrinsics" / "a.txt").string(), "50 0 6 0 51 4 0 0 nan");
     expect_error([&] { load_dataset(tmp.path().string()); },
                  {(train / "intrinsics" / "a.txt").string(), "NaN"});
+}
+
+TEST(DatasetNerfOsr, PointCloudNextToTheSplits) {
+    TempDir tmp;
+    const fs::path final_dir = tmp.path() / "final";
+    write_nerfosr_view(final_dir / "train", "a", 12, 8, false);
+    EXPECT_TRUE(load_dataset(tmp.path().string()).point_xyz.empty());
+    EXPECT_EQ(load_dataset(tmp.path().string()).points_path, (final_dir / "points3d.ply").string());
+    PlyVertexTable table;
+    table.count = 2;
+    table.add("x", {1, 4}), table.add("y", {2, 5}), table.add("z", {3, 6});
+    write_ply_vertices((final_dir / "points3d.ply").string(), table);
+    const Dataset d = load_dataset(tmp.path().string());
+    ASSERT_EQ(d.point_xyz.size(), 2u);
+    EXPECT_EQ(d.point_xyz[1].y, 5);
+    EXPECT_EQ(d.point_rgb[1].x, 0.5f);  // no colours: grey
+    table.add("red", {255, 0}), table.add("green", {0, 51}), table.add("blue", {0, 0});
+    write_ply_vertices((final_dir / "points3d.ply").string(), table);
+    EXPECT_NEAR(load_dataset(tmp.path().string()).point_rgb[1].y, 0.2f, 1e-6f);
+    PlyVertexTable empty;
+    empty.add("x", {}), empty.add("y", {}), empty.add("z", {});
+    write_ply_vertices((final_dir / "points3d.ply").string(), empty);
+    expect_error([&] { load_dataset(tmp.path().string()); }, {"points3d.ply", "no points"});
 }
 
 }  // namespace

@@ -116,6 +116,9 @@ TEST_F(ShText, NonFiniteIsAnErrorNamingTheLine) {
     expect_error("1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 inf\n",
                  "line 9: 'inf' is not a finite");
     expect_error("1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 1e999\n", "line 9: '1e999'");
+    // Finite, but its radiance is not: it gave an all-Inf preview EXR that the tool refused to read back.
+    expect_error("1e308 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6\n7 8 9\n",
+                 "line 1: '1e308' is out of range");
 }
 
 TEST_F(ShText, WrongCountsAreErrors) {

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <string>
 
+#include "lumigauss/io/dataset.h"
+#include "lumigauss/io/ply.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/synth/synth.h"
 #include "lumigauss/train/checkpoint.h"
@@ -35,6 +37,72 @@ TrainingRunRequest request(const std::string& out, std::int64_t iterations) {
     r.config = train_preset("fast");
     r.config.iterations = iterations;
     return r;
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+    fs::create_directories(path.parent_path());
+    std::ofstream(path) << text;
+}
+
+// The tiny COLMAP scene rewritten in the NeRF-OSR layout (final/{train,test}/{rgb,pose,intrinsics}/), without
+// its SfM points.
+std::string tiny_scene_as_nerfosr(const TempDir& tmp) {
+    const Dataset colmap = load_dataset(tiny_scene());
+    const fs::path final_dir = fs::path(tmp.str()) / "nerfosr" / "final";
+    for (const View& v : colmap.views) {
+        const fs::path split = final_dir / (v.split == Split::Test ? "test" : "train");
+        const std::string stem = fs::path(v.name).stem().string();
+        fs::create_directories(split / "rgb");
+        fs::copy_file(v.image_path, split / "rgb" / fs::path(v.image_path).filename());
+        const Camera& c = v.camera;
+        const Vec3d centre = c.center();
+        std::string pose;
+        for (int i = 0; i < 3; ++i)
+            pose += std::to_string(c.rotation(0, i)) + " " + std::to_string(c.rotation(1, i)) + " " +
+                    std::to_string(c.rotation(2, i)) + " " + std::to_string(centre[i]) + "\n";
+        write_text(split / "pose" / (stem + ".txt"), pose + "0 0 0 1\n");
+        write_text(split / "intrinsics" / (stem + ".txt"),
+                   std::to_string(c.fx) + " 0 " + std::to_string(c.cx) + " 0 " + std::to_string(c.fy) + " " +
+                       std::to_string(c.cy) + " 0 0 1");
+    }
+    return final_dir.parent_path().string();
+}
+
+TEST(TrainingRun, ANerfOsrSceneTrainsFromItsPointCloud) {
+    TempDir tmp("training_run_nerfosr");
+    TrainingRunRequest r = request(tmp / "run", 3);
+    r.scene = tiny_scene_as_nerfosr(tmp);
+    const std::string points = (fs::path(r.scene) / "final" / "points3d.ply").string();
+    try {
+        TrainingRun run(r);
+        ADD_FAILURE() << "a scene without SfM points was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(points), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("SfM points"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(fs::path(r.out) / "config.json")) << "a refused run left files";
+
+    const Dataset colmap = load_dataset(tiny_scene());
+    PlyVertexTable table;
+    table.count = colmap.point_xyz.size();
+    for (int axis = 0; axis < 3; ++axis) {
+        std::vector<float> xyz, rgb;
+        for (std::size_t i = 0; i < table.count; ++i) {
+            xyz.push_back(colmap.point_xyz[i][axis]);
+            rgb.push_back(std::round(255 * colmap.point_rgb[i][axis]));
+        }
+        table.add(std::string(1, "xyz"[axis]), std::move(xyz));
+        table.add(std::array{"red", "green", "blue"}[std::size_t(axis)], std::move(rgb));
+    }
+    write_ply_vertices(points, table);
+    const Dataset nerfosr = load_dataset(r.scene);
+    EXPECT_EQ(nerfosr.points_path, points);
+    ASSERT_EQ(nerfosr.point_xyz.size(), colmap.point_xyz.size());
+    EXPECT_NEAR(nerfosr.point_rgb[0].y, colmap.point_rgb[0].y, 0.5 / 255);
+    TrainingRun run(r);
+    EXPECT_EQ(run.run(
+                  0, [] { return false; }, [](const StepReport&) {}),
+              TrainingOutcome::Finished);
 }
 
 TEST(TrainingRun, ForceRemovesThePreviousRunBeforeTheNewOneCheckpoints) {

@@ -92,6 +92,16 @@ class Reader {
     std::uint64_t count_ = 0, record_ = 0;
 };
 
+// A camera's width or height: a uint64 on disk. Cast to int unchecked, 2^32 + 640 would read as 640.
+int image_side(Reader& in, const char* which) {
+    const auto side = in.get<std::uint64_t>();
+    constexpr std::uint64_t kMaxSide = 1 << 20;
+    if (side == 0 || side > kMaxSide)
+        in.fail("image " + std::string(which) + " " + std::to_string(side) + " is not between 1 and " +
+                std::to_string(kMaxSide));
+    return int(side);
+}
+
 std::map<int, ColmapCamera> read_cameras(const std::string& path) {
     Reader in(path);
     std::map<int, ColmapCamera> cameras;
@@ -103,8 +113,8 @@ std::map<int, ColmapCamera> read_cameras(const std::string& path) {
         const int model_id = in.get<std::int32_t>();
         cam.model = colmap_model_name(model_id);
         if (cam.model.empty()) in.fail("unknown camera model id " + std::to_string(model_id));
-        cam.width = int(in.get<std::uint64_t>());
-        cam.height = int(in.get<std::uint64_t>());
+        cam.width = image_side(in, "width");
+        cam.height = image_side(in, "height");
         cam.params.resize(std::size_t(colmap_model_num_params(cam.model)));
         for (double& p : cam.params) p = in.get<double>();
         colmap_detail::check_camera(cam, path, in.where());

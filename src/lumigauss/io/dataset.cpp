@@ -153,6 +153,7 @@ Dataset load_dataset(const std::string& root, const DatasetOptions& options) {
     d.downscale = f;
     d.point_xyz = std::move(raw.point_xyz);
     d.point_rgb = std::move(raw.point_rgb);
+    d.points_path = std::move(raw.points_path);
     d.views.reserve(raw.views.size());
     for (const RawView& r : raw.views) d.views.push_back(finish_view(r, f));
     drop_far_points(d);

@@ -6,8 +6,9 @@
 //             masks/a/b.jpg.png, COLMAP's own naming), optional <root>/sky_masks/ (the same naming; 255 =
 //             the pixel sees the sky, as a semantic segmentation gives it), optional <root>/*split.csv
 //             (`filename;split`).
-//   NeRF-OSR: <root>/final/ (or <root> itself) with {train,validation,test}/{rgb,pose,intrinsics,mask}/ and
-//             optional {train,validation,test}/sky_mask/.
+//   NeRF-OSR: <root>/final/ (or <root> itself) with {train,validation,test}/{rgb,pose,intrinsics,mask}/,
+//             optional {train,validation,test}/sky_mask/ and optional points3d.ply (SfM points in the poses'
+//             world, vertex x y z [red green blue], as NeuSky's overlay ships them; training needs them).
 // Pixels are loaded lazily (load_image, load_mask); load_dataset only checks that every file is there and
 // that its header size matches its camera.
 //
@@ -51,7 +52,10 @@ struct Dataset {
     std::string root;
     std::string format;                       // "colmap-binary", "colmap-text" or "nerf-osr"
     std::vector<View> views;                  // sorted by name
-    std::vector<Vec3f> point_xyz, point_rgb;  // SfM points (rgb in 0..1); empty for NeRF-OSR
+    std::vector<Vec3f> point_xyz, point_rgb;  // SfM points (rgb in 0..1); may be empty for NeRF-OSR
+    // The file the SfM points come from (COLMAP: sparse/0/points3D.{bin,txt}; NeRF-OSR: final/points3d.ply,
+    // which the layout may lack), for messages about them.
+    std::string points_path;
     int downscale = 1;
     // SfM points dropped at load for lying absurdly far from the cameras (kFarPointRadii x the cameras'
     // extent about their centroid, io/scene_extent.h): one point at 1e20 made the initial surfel scale

@@ -184,6 +184,7 @@ RawScene load_colmap_layout(const std::string& root, const DatasetOptions& optio
     assign_splits(scene.views, root, options.holdout_every);
     scene.point_xyz = model.point_xyz;
     scene.point_rgb = model.point_rgb;
+    scene.points_path = (fs::path(files.sparse) / (files.binary ? "points3D.bin" : "points3D.txt")).string();
     return scene;
 }
 

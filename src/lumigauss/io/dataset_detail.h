@@ -19,6 +19,7 @@ struct RawScene {
     std::string format;
     std::vector<RawView> views;
     std::vector<Vec3f> point_xyz, point_rgb;
+    std::string points_path;  // Dataset::points_path
 };
 
 // True when the folder holds the layout; the loaders throw Error for anything missing inside it.

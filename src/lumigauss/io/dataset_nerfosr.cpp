@@ -5,7 +5,8 @@
 // pose/<stem>.txt: 16 numbers, a row-major 4x4 camera-to-world matrix with OpenCV camera axes (x right, y
 // down, z forward), written by NeRF-OSR's cvt.py as the inverse of COLMAP's world-to-camera with no axis
 // flip. We assume exactly that: R_w2c = R_c2w^T, t_w2c = -R_c2w^T C (C = last column), no axis change, the
-// world (NeRF++-normalised COLMAP world, y roughly down) kept as is. 12 numbers (3x4) are accepted too.
+// world (NeRF++-normalised COLMAP world, y roughly down) kept as is. 12 numbers (3x4) are accepted too. The
+// rotation must be proper (det +1): a reflected pose mirrors the scene, which no camera can see.
 // intrinsics/<stem>.txt: 16 numbers, a 4x4 whose top-left 3x3 is K (9 numbers, a bare K, are accepted too);
 // fx = K00, fy = K11, cx = K02, cy = K12. NeRF-OSR casts rays through pixel centres (u + 0.5, v + 0.5) with
 // inv(K), which is our Camera convention, so K is used unchanged. Image sizes come from the rgb files.
@@ -15,6 +16,7 @@
 #include <fstream>
 
 #include "lumigauss/io/dataset_detail.h"
+#include "lumigauss/io/ply.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss::dataset_detail {
@@ -70,6 +72,12 @@ void set_pose_from_c2w(Camera& cam, const std::vector<double>& m, const std::str
         for (int j = 0; j < 3; ++j)
             if (std::abs(should_be_identity(i, j) - (i == j ? 1.0 : 0.0)) > 1e-3)
                 fail_in_file(path, "the rotation part of the camera-to-world pose is not orthonormal");
+    const Mat3d& r = r_c2w;
+    const double det = r(0, 0) * (r(1, 1) * r(2, 2) - r(1, 2) * r(2, 1)) -
+                       r(0, 1) * (r(1, 0) * r(2, 2) - r(1, 2) * r(2, 0)) +
+                       r(0, 2) * (r(1, 0) * r(2, 1) - r(1, 1) * r(2, 0));
+    if (det < 0)
+        fail_in_file(path, "the rotation part of the camera-to-world pose is a reflection (determinant -1)");
     cam.rotation = transpose(r_c2w);
     cam.translation = -(cam.rotation * centre);
 }
@@ -110,6 +118,31 @@ void add_split(const fs::path& split_dir, Split split, RawScene& scene) {
     }
 }
 
+// SfM points from a PLY of vertices x, y, z and optional red, green, blue (0..255 as integers, or 0..1).
+void read_points_ply(const std::string& path, RawScene& scene) {
+    const PlyVertexTable table = read_ply_vertices(path);
+    if (table.count == 0) fail_in_file(path, "the point cloud has no points");
+    const auto& x = table.column("x", path);
+    const auto& y = table.column("y", path);
+    const auto& z = table.column("z", path);
+    const bool rgb = table.has("red") && table.has("green") && table.has("blue");
+    float rgb_max = 0;
+    if (rgb)
+        for (const char* c : {"red", "green", "blue"})
+            for (float v : table.column(c, path)) rgb_max = std::max(rgb_max, v);
+    const float rgb_scale = rgb_max > 1 ? 1.0f / 255.0f : 1.0f;
+    for (std::size_t i = 0; i < table.count; ++i) {
+        const Vec3f p{x[i], y[i], z[i]};
+        if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)))
+            fail_in_file(path, "point " + std::to_string(i) + " has a NaN or Inf coordinate");
+        scene.point_xyz.push_back(p);
+        scene.point_rgb.push_back(rgb ? Vec3f{table.column("red", path)[i], table.column("green", path)[i],
+                                              table.column("blue", path)[i]} *
+                                            rgb_scale
+                                      : Vec3f{0.5f, 0.5f, 0.5f});
+    }
+}
+
 }  // namespace
 
 bool is_nerfosr_layout(const std::string& root) {
@@ -124,6 +157,8 @@ RawScene load_nerfosr_layout(const std::string& root) {
     for (const auto& s : kSplits)
         if (fs::is_directory(final_dir / s.folder / "rgb", ec))
             add_split(final_dir / s.folder, s.split, scene);
+    scene.points_path = (final_dir / "points3d.ply").string();
+    if (fs::is_regular_file(scene.points_path, ec)) read_points_ply(scene.points_path, scene);
     return scene;
 }
 

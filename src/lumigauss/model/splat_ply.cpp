@@ -29,6 +29,7 @@ int degree_from_rest_count(int rest, const std::string& path) {
 
 ViewDependentSurfels load_2dgs_ply(const std::string& path) {
     const PlyVertexTable t = read_ply_vertices(path);
+    if (t.count == 0) fail_in_file(path, "the model has no surfels (0 vertices)");
     int rest = 0;
     while (t.has("f_rest_" + std::to_string(rest))) ++rest;
     ViewDependentSurfels m;

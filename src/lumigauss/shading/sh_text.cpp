@@ -13,7 +13,12 @@
 namespace lumigauss {
 namespace {
 
-// One token as a finite double, or an Error naming file and line.
+// Larger coefficients are refused: 1e308 is finite, but the radiance summed from it is not (an all-Inf
+// preview EXR that the tool then refused to read), and squares of anything past ~1e19 overflow the single
+// precision of panoramas and renders. No light is within many orders of magnitude of this.
+constexpr double kMaxShCoefficient = 1e15;
+
+// One token as a finite double within +-kMaxShCoefficient, or an Error naming file and line.
 double parse_number(const std::string& token, const std::string& path, int line_no) {
     // from_chars rejects a leading '+', which other writers may emit.
     const char* first = token.data() + (token.front() == '+' ? 1 : 0);
@@ -23,6 +28,8 @@ double parse_number(const std::string& token, const std::string& path, int line_
     const std::string where = "line " + std::to_string(line_no) + ": ";
     if (ec != std::errc{} || end != last) fail_in_file(path, where + "'" + token + "' is not a number");
     if (!std::isfinite(value)) fail_in_file(path, where + "'" + token + "' is not a finite number");
+    if (std::abs(value) > kMaxShCoefficient)
+        fail_in_file(path, where + "'" + token + "' is out of range (|value| <= 1e15)");
     return value;
 }
 

@@ -175,8 +175,7 @@ Trainer::Trainer(std::vector<TrainView> views, const std::vector<Vec3f>& point_x
     : views_(std::move(views)), scratch_(std::make_unique<Scratch>()) {
     validate_train_config(config);
     if (views_.empty()) throw Error("training needs at least one training photo; the dataset has none");
-    if (point_xyz.empty())
-        throw Error("training starts from SfM points, and the dataset has none (sparse/0/points3D)");
+    if (point_xyz.empty()) throw Error("training starts from SfM points, and none were given");
     state_.config = config;
     std::vector<View> cams(views_.size());
     for (std::size_t i = 0; i < views_.size(); ++i) cams[i].camera = views_[i].camera;

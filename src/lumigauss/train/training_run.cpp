@@ -34,6 +34,19 @@ void remove_previous_run(const RunPaths& paths) {
     fs::remove_all(fs::path(paths.dir) / "previews");
 }
 
+// Training starts from SfM points; a scene without any says where they were looked for.
+[[noreturn]] void fail_without_points(const Dataset& data) {
+    if (data.format == "nerf-osr")
+        fail_in_file(
+            data.points_path,
+            "not found: training starts from SfM points, and this NeRF-OSR scene has none. Put them "
+            "there as a PLY of vertices x y z [red green blue] in the poses' world (NeuSky's NeRF-OSR "
+            "overlay ships final/points3d.ply), or train on the COLMAP layout of the scene "
+            "(LumiGauss's processed NeRF-OSR release: images/, sparse/0/)");
+    fail_in_file(data.points_path.empty() ? data.root : data.points_path,
+                 "training starts from SfM points, and the scene has none");
+}
+
 }  // namespace
 
 TrainingRun::TrainingRun(const TrainingRunRequest& request) : paths_(run_paths(request.out)) {
@@ -62,6 +75,7 @@ TrainingRun::TrainingRun(const TrainingRunRequest& request) : paths_(run_paths(r
         DatasetOptions dopt;
         dopt.downscale = request.config.downscale;
         const Dataset data = load_dataset(request.scene, dopt);
+        if (data.point_xyz.empty()) fail_without_points(data);
         sfm_points_ = data.point_xyz.size();
         far_points_dropped_ = data.far_points_dropped;
         far_point_limit_ = data.far_point_limit;
