@@ -54,7 +54,10 @@ void print_views(const Dataset& d, const std::string& mask_mode) {
 }
 
 void print_extent(const Dataset& d) {
-    std::printf("points:        %zu\n", d.point_xyz.size());
+    if (d.point_xyz.empty())
+        std::printf("points:        none (training needs SfM points in %s)\n", d.points_path.c_str());
+    else
+        std::printf("points:        %zu (%s)\n", d.point_xyz.size(), d.points_path.c_str());
     if (d.far_points_dropped > 0)
         std::printf("               (%zu more dropped: farther than %.4g from the cameras' centre)\n",
                     d.far_points_dropped, d.far_point_limit);
