@@ -94,19 +94,26 @@ void run_gt_env(const EvalOptions& o) {
         std::printf(
             "  evaluated pixels left empty (alpha <= 0.5): %.2f %%; shadowed PSNR over the others %.2f\n",
             100 * result.empty_fraction, result.mean_covered_shadowed_psnr);
+        if (result.image_scaled)
+            std::printf(
+                "  light scale per channel fitted on the training images: k = %.4g %.4g %.4g; "
+                "shadowed PSNR under it %.2f SSIM %.4f\n",
+                result.image_light_scale[0], result.image_light_scale[1], result.image_light_scale[2],
+                result.mean_image_scaled_shadowed.psnr, result.mean_image_scaled_shadowed.ssim);
     }
     // One key=value line for scripts (bench/plaza.sh); "nan" where the scene has no such ground truth.
     const double nan = std::numeric_limits<double>::quiet_NaN();
     std::printf(
         "eval-summary: shadowed_psnr=%.4f shadowed_ssim=%.4f unshadowed_psnr=%.4f unshadowed_ssim=%.4f "
         "albedo_psnr=%.4f normal_mean_deg=%.3f normal_median_deg=%.3f render_ms=%.2f sky_alpha=%.4f "
-        "light_residual=%.4f empty=%.4f covered_psnr=%.4f\n",
+        "light_residual=%.4f empty=%.4f covered_psnr=%.4f scaled_psnr=%.4f\n",
         result.mean_shadowed.psnr, result.mean_shadowed.ssim, result.mean_unshadowed.psnr,
         result.mean_unshadowed.ssim, result.has_albedo ? result.mean_albedo.psnr : nan,
         result.has_normal ? result.mean_normal.mean_deg : nan,
         result.has_normal ? result.mean_normal.median_deg : nan, result.median_render_ms,
         result.has_sky ? result.sky_alpha_fraction : nan, result.light.relative_residual,
-        result.empty_fraction, result.mean_covered_shadowed_psnr);
+        result.empty_fraction, result.mean_covered_shadowed_psnr,
+        result.image_scaled ? result.mean_image_scaled_shadowed.psnr : nan);
     std::printf("eval: wrote %s/metrics.json and %s/report.md (%.1f s)\n", o.out.c_str(), o.out.c_str(), s);
 }
 

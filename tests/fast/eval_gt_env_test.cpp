@@ -239,6 +239,39 @@ TEST(EvalGtEnv, MetricsAreInvariantUnderTheAlbedoLightGauge) {
     }
 }
 
+// The image-space light scale (header, step 8) follows the per-channel colour gauge that one scalar k cannot:
+// albedo_c * g_c with light_c * g_c^(-2.2) renders every training photo the same for any g per channel, so
+// the fitted k_c must move by exactly g_c^(-2.2) and the image-scaled scores must not move, while the
+// headline (one k from the learned lights) sees a colour cast.
+TEST(EvalGtEnv, ImageLightScaleFollowsTheColourGauge) {
+    const std::string& root = tiny_scene();
+    const Dataset scene = load_dataset(root);
+    const GtSceneMeta meta = load_gt_scene_meta(root);
+    const RelightableRun plain = oracle_run(root, 1.0);
+    RelightableRun tinted = plain;
+    const std::array<double, 3> g{0.8, 1.0, 1.25};
+    std::vector<float>& albedo = tinted.model.param(ModelParam::Albedo);
+    for (std::size_t i = 0; i < albedo.size(); ++i) {
+        const double c = g[i % 3];  // the albedo is RGB per surfel
+        albedo[i] = float((c * (sh_const::kY00 * albedo[i] + 0.5) - 0.5) / sh_const::kY00);
+    }
+    const std::array<double, 3> k_plain = fit_image_light_scale(plain, scene, meta, {}).value();
+    const std::array<double, 3> k_tinted = fit_image_light_scale(tinted, scene, meta, {}).value();
+    for (std::size_t c = 0; c < 3; ++c) {
+        EXPECT_NEAR(k_tinted[c] / k_plain[c], std::pow(g[c], -2.2), 1e-4) << c;
+        EXPECT_NEAR(k_plain[c], 1.0, 0.25) << "the true surfels under the true light need about k = 1";
+    }
+    GtEnvOptions opt;
+    opt.keep_panels = false;
+    const GtEnvResult a = evaluate_gt_env(plain, scene, meta, opt);
+    const GtEnvResult b = evaluate_gt_env(tinted, scene, meta, opt);
+    ASSERT_TRUE(a.image_scaled && b.image_scaled);
+    EXPECT_NEAR(a.mean_image_scaled_shadowed.psnr, b.mean_image_scaled_shadowed.psnr, 1e-3);
+    EXPECT_GT(a.mean_shadowed.psnr, b.mean_shadowed.psnr + 0.5) << "one k cannot undo a colour cast";
+    opt.image_light_scale = false;
+    EXPECT_FALSE(evaluate_gt_env(plain, scene, meta, opt).image_scaled);
+}
+
 TEST(EvalGtEnv, AWrongLightScaleScoresWorse) {
     // The same model with its learned light 4x too bright for every photo (training photos included) no
     // longer renders its training photos; the fitted k follows the learned light, so the test renders are
@@ -273,6 +306,7 @@ TEST(EvalGtEnv, EmptyPixelsAreCountedOverTheEvaluationMask) {
     const GtEnvResult none = evaluate_gt_env(faded, scene, meta, opt);
     EXPECT_EQ(none.empty_fraction, 1.0);
     EXPECT_TRUE(std::isnan(none.mean_covered_shadowed_psnr));
+    EXPECT_FALSE(none.image_scaled) << "no covered training pixel: no image-space light scale";
     for (const GtEnvImageResult& im : none.images) EXPECT_EQ(im.empty_fraction, 1.0) << im.name;
     EXPECT_TRUE(gt_env_metrics_json(none, {"run", root})["mean"].contains("empty"));
 }

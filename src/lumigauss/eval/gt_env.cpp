@@ -7,6 +7,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
 
 #include "lumigauss/io/text_file.h"
 #include "lumigauss/math/quaternion.h"
@@ -64,6 +65,38 @@ double to_linear(double v) {
 }
 double to_gamma(double v) {
     return std::pow(std::max(v, 0.0), 1.0 / kGamma);
+}
+
+// The evaluation mask of a view (header, step 3), and whether the scene has a gt/mask for it.
+Image evaluation_mask(const GtSceneMeta& meta, const Dataset& scene, const View& v, bool& has_gt_mask) {
+    const std::string gt_mask_path = gt_path(meta.root, "mask", v.name);
+    has_gt_mask = fs::exists(gt_mask_path);
+    const Image scene_mask = binarize_mask(scene.load_mask(v), 0.5f);
+    return has_gt_mask
+               ? multiply_masks(
+                     official_eval_mask(load_gt_image(gt_mask_path, v.camera.width, v.camera.height, 1)),
+                     scene_mask)
+               : official_eval_mask(scene_mask);
+}
+
+// The environment of a view: scale_c * exposure * (true SH of its condition), per channel.
+ShCoeffs<float> scaled_true_env(const GtSceneMeta& meta, const GtImageMeta& im,
+                                const std::array<double, 3>& scale) {
+    const ShCoeffs<double> truth = load_condition_sh(meta, im.condition);
+    ShCoeffs<float> env;
+    for (int j = 0; j < kShCount; ++j)
+        for (int c = 0; c < 3; ++c) env.c[j][c] = float(truth.c[j][c] * scale[std::size_t(c)] * im.exposure);
+    return env;
+}
+
+// The shadowed render of a view under `env`, clamped, with the sky behind it when the run was trained so.
+Image shadowed_panel(const RelightableRun& run, RelitRenderer& renderer, const Camera& camera,
+                     const ShCoeffs<float>& env) {
+    const RasterImages<float>& relit = renderer.render(camera, env);
+    Image shadowed = raster_channels(relit, kRelitShadowed, 3);
+    if (run.sky_background)
+        shadowed = over_background_image(shadowed, alpha_image(relit), sky_image(camera, env));
+    return clamp01(shadowed);
 }
 
 AlbedoMetrics albedo_metrics(const Image& predicted, const Image& truth, const Image& mask) {
@@ -248,6 +281,39 @@ LightScaleFit fit_run_light_scale(const RelightableRun& run, const GtSceneMeta& 
     return fit_light_scale(learned, truth, exposure, names);
 }
 
+std::optional<std::array<double, 3>> fit_image_light_scale(const RelightableRun& run, const Dataset& scene,
+                                                           const GtSceneMeta& meta,
+                                                           const std::vector<std::string>& exclude,
+                                                           RasterBackend backend) {
+    RelitRenderer renderer(run.model, backend);
+    std::array<double, 3> rp{}, rr{};
+    for (const View* v : scene.split(Split::Train)) {
+        const GtImageMeta* im = meta.find(v->name);
+        if (im == nullptr || std::find(exclude.begin(), exclude.end(), v->name) != exclude.end()) continue;
+        const RasterImages<float>& relit = renderer.render(v->camera, scaled_true_env(meta, *im, {1, 1, 1}));
+        const Image photo = scene.load_image(*v);
+        bool has_gt_mask = false;
+        const Image mask = evaluation_mask(meta, scene, *v, has_gt_mask);
+        for (std::size_t q = 0; q < mask.pixels.size(); ++q) {
+            if (!(mask.pixels[q] > 0.5f) || relit.alpha[q] <= 0.5f) continue;
+            const std::size_t i = 3 * q, o = std::size_t(relit.channels) * q + kRelitShadowed;
+            // A clipped photo pixel says only "at least 1": it would pull the scale down.
+            if (std::max({photo.pixels[i], photo.pixels[i + 1], photo.pixels[i + 2]}) >= 0.99f) continue;
+            for (std::size_t c = 0; c < 3; ++c) {
+                const double r = relit.color[o + c], p = photo.pixels[i + c];
+                if (!std::isfinite(r)) continue;
+                rp[c] += r * p, rr[c] += r * r;
+            }
+        }
+    }
+    std::array<double, 3> k{1, 1, 1};
+    for (std::size_t c = 0; c < 3; ++c) {
+        if (!(rr[c] > 0 && rp[c] > 0)) return std::nullopt;
+        k[c] = std::pow(rp[c] / rr[c], 1.0 / surfel_const::kInvGamma);  // display colour goes as E^(1/2.2)
+    }
+    return k;
+}
+
 // ---- Protocol -------------------------------------------------------------------------------------------
 
 GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, const GtSceneMeta& meta,
@@ -262,6 +328,11 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
     if (options.views != Split::Train)
         for (const View* v : views) test_names.push_back(v->name);
     result.light = fit_run_light_scale(run, meta, test_names);
+    if (options.image_light_scale)
+        if (const auto k = fit_image_light_scale(run, scene, meta, test_names, options.backend)) {
+            result.image_scaled = true;
+            result.image_light_scale = *k;
+        }
 
     // One pass per view gives both colours, both intensities and the albedo (relight/relit_render.h).
     RelitRenderer renderer(run.model, options.backend);
@@ -301,12 +372,9 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
 
         // Evaluation mask.
         const std::string gt_mask_path = gt_path(meta.root, "mask", v->name);
-        const bool has_gt_mask = fs::exists(gt_mask_path);
+        bool has_gt_mask = false;
+        p.mask = evaluation_mask(meta, scene, *v, has_gt_mask);
         result.gt_mask = (result.images.empty() || result.gt_mask) && has_gt_mask;
-        Image scene_mask = binarize_mask(scene.load_mask(*v), 0.5f);
-        p.mask = has_gt_mask
-                     ? multiply_masks(official_eval_mask(load_gt_image(gt_mask_path, w, h, 1)), scene_mask)
-                     : official_eval_mask(scene_mask);
         r.mask_pixels = mask_pixels(p.mask);
         if (r.mask_pixels == 0)
             fail_in_file(has_gt_mask ? gt_mask_path : v->image_path,
@@ -368,6 +436,12 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
                 p.normal_error.pixels[q] = std::isfinite(angle) ? float(std::min(1.0, angle / 45.0)) : 0.f;
             }
         }
+        // The same view under the image-space light scale (a second render: the sky and the clamp follow it).
+        if (result.image_scaled)
+            r.image_scaled_shadowed =
+                image_metrics(shadowed_panel(run, renderer, v->camera,
+                                             scaled_true_env(meta, *im, result.image_light_scale)),
+                              p.truth, p.mask, options.ssim);
         result.images.push_back(std::move(r));
     }
 
@@ -416,6 +490,7 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
     std::size_t normal_images = 0;
     for (const GtEnvImageResult& r : result.images) {
         add_metrics(result.mean_shadowed, r.shadowed);
+        add_metrics(result.mean_image_scaled_shadowed, r.image_scaled_shadowed);
         add_metrics(result.mean_unshadowed, r.unshadowed);
         if (result.has_albedo)
             add_albedo(result.mean_albedo, r.albedo), add_albedo(result.mean_albedo_gamma, r.albedo_gamma);

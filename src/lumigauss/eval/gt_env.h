@@ -37,9 +37,18 @@
 // 7. Normals (when gt/normal exists): the rasterised world normal map, normalised, against gt/normal decoded
 //    as 2v - 1 and normalised; angles in degrees over the evaluation mask; a pixel with no rendered normal
 //    counts as 90 deg. Per image mean and median; overall the mean of those and the pooled statistics.
+// 8. A second light scale, fitted where the model is observed: the shadowed renders of the TRAINING photos
+//    under exposure * true SH, fitted to those photos in image space, one scale per channel (covered,
+//    unclipped pixels of their evaluation masks; never a test photo). Step 1 compares SH coefficients over
+//    the whole sphere of normals, so it also weighs what no photo constrains (light from below; the learned
+//    lights' irradiance of a downward normal is 0.5-2 times that of an upward one on plaza, the truth's
+//    0.05), and one scalar cannot follow the model's colour gauge (albedo_c * s_c with E_c * s_c^(-2.2)
+//    renders every training photo the same, for each channel apart). The test views are scored again under
+//    k_c * exposure * true SH ("image-scaled"); the metrics of 3 stay the protocol's headline.
 // Ground-truth images are area-resampled to the evaluated resolution (-r) like the photos.
 #include <array>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -153,6 +162,7 @@ struct GtEnvImageResult {
     double empty_fraction = 0;
     double covered_shadowed_psnr = 0;
     ImageMetrics shadowed, unshadowed;
+    ImageMetrics image_scaled_shadowed;  // shadowed, under the image-space light scale (header, step 8)
     bool has_albedo = false, has_normal = false;
     AlbedoMetrics albedo, albedo_gamma;
     AngularErrorStats normal;
@@ -162,12 +172,15 @@ struct GtEnvImageResult {
 struct GtEnvResult {
     Split views = Split::Test;  // which photos were scored (GtEnvOptions::views)
     LightScaleFit light;
+    bool image_scaled = false;  // step 8 ran (GtEnvOptions::image_light_scale) and found usable pixels
+    std::array<double, 3> image_light_scale{1, 1, 1};  // its k per channel
     int downscale = 1;
     bool gt_mask = false;                         // every test image had a gt/mask
     bool has_albedo = false, has_normal = false;  // every test image had gt/albedo, gt/normal
     std::vector<GtEnvImageResult> images;
     // Means over images (PSNR averaged as PSNR, as officially).
     ImageMetrics mean_shadowed, mean_unshadowed;
+    ImageMetrics mean_image_scaled_shadowed;
     double median_render_ms = 0;
     bool has_sky = false;                   // some scored image had sky pixels
     double sky_alpha_fraction = 0;          // over every sky pixel of every scored image
@@ -187,7 +200,18 @@ struct GtEnvOptions {
     // own TRUE environment (not the learned one); the light scale is then fitted on all training photos.
     Split views = Split::Test;
     RasterBackend backend = RasterBackend::Cpu;
+    // Step 8: also fit the light scale per channel on the training images and score the test views under it.
+    bool image_light_scale = true;
 };
+
+// Step 8's scale: per channel, the least-squares scale s_c of the shadowed renders of the training photos
+// under exposure * true SH (k = 1) onto the photos, over evaluated, covered (alpha > 0.5), unclipped pixels;
+// k_c = s_c^2.2. Photos named in `exclude` are skipped. Nothing when no pixel is usable (a model that covers
+// none of them).
+std::optional<std::array<double, 3>> fit_image_light_scale(const RelightableRun& run, const Dataset& scene,
+                                                           const GtSceneMeta& meta,
+                                                           const std::vector<std::string>& exclude,
+                                                           RasterBackend backend = RasterBackend::Cpu);
 
 // Runs the protocol on every test view of `scene` (loaded at the resolution to evaluate). Throws Error
 // naming the file for a test photo missing from meta.json, a missing SH file, or an empty evaluation mask.

@@ -199,6 +199,7 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
             e["sky"] = {{"pixels", im.sky_pixels}, {"alpha_above_half", number(im.sky_alpha_fraction)}};
         e["empty"] = {{"fraction", number(im.empty_fraction)},
                       {"shadowed_psnr_covered", number(im.covered_shadowed_psnr)}};
+        if (r.image_scaled) e["shadowed_image_scaled"] = image_metrics_json(im.image_scaled_shadowed);
         images.push_back(std::move(e));
     }
     j["images"] = images;
@@ -219,7 +220,15 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
         {"meaning",
          "share of all evaluated pixels where the render's alpha <= 0.5 (no surface), and the mean "
          "shadowed PSNR over the other evaluated pixels"}};
+    if (r.image_scaled) mean["shadowed_image_scaled"] = image_metrics_json(r.mean_image_scaled_shadowed);
     j["mean"] = mean;
+    if (r.image_scaled)
+        j["image_light_scale"] = {
+            {"rgb", rgb_json(r.image_light_scale)},
+            {"meaning",
+             "k per channel fitted in image space on the training photos (shadowed renders under exposure "
+             "* true SH against the photos); the test views are scored under it again as "
+             "'shadowed_image_scaled'"}};
     j["median_render_ms"] = r.median_render_ms;
     if (r.has_normal) j["normal_all_pixels"] = normal_json(r.pooled_normal);
     return j;
@@ -282,6 +291,14 @@ std::string gt_env_report_markdown(const GtEnvResult& r, const ReportSources& sr
              " deg (means of the per-image values); over all pixels: mean " +
              fmt("%.2f", r.pooled_normal.mean_deg) + ", median " + fmt("%.2f", r.pooled_normal.median_deg) +
              " deg.\n";
+    if (r.image_scaled)
+        s += "\nUnder the light scale fitted per channel on the training images (k = " +
+             fmt("%.4g", r.image_light_scale[0]) + " " + fmt("%.4g", r.image_light_scale[1]) + " " +
+             fmt("%.4g", r.image_light_scale[2]) +
+             "; it follows the model's colour gauge and ignores light "
+             "no photo constrains): shadowed PSNR " +
+             fmt("%.2f", r.mean_image_scaled_shadowed.psnr) + " dB, SSIM " +
+             fmt("%.4f", r.mean_image_scaled_shadowed.ssim) + ".\n";
     s += "\nEvaluated pixels the model leaves empty (alpha <= 0.5): " + fmt("%.2f", 100 * r.empty_fraction) +
          " %; shadowed PSNR over the covered ones " + fmt("%.2f", r.mean_covered_shadowed_psnr) + " dB.\n";
     if (r.has_sky)
