@@ -22,6 +22,7 @@
 #include "lumigauss/eval/sol_nerf.h"
 #include "lumigauss/eval/sol_nerf_report.h"
 #include "lumigauss/io/dataset.h"
+#include "lumigauss/model/scene_record.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/render/rasterizer.h"
 #include "lumigauss/util/error.h"
@@ -57,6 +58,7 @@ void run_gt_env(const EvalOptions& o) {
     const RelightableRun run = load_relightable_run(o.run);
     const DatasetOptions dopt = evaluated_resolution(o, run.downscale);
     const Dataset scene = load_dataset(o.scene, dopt);
+    check_run_scene(o.run, scene);
     if (!o.quiet)
         std::printf("eval: %zu surfels, %zu training photos from %s; %zu %s views of %s at 1/%d\n",
                     run.model.size(), run.image_names.size(), o.run.c_str(),
@@ -166,6 +168,7 @@ void run_sol_nerf(const EvalOptions& o) {
     const TrainedRun run = load_run_or_ply(o.run);
     const DatasetOptions dopt = evaluated_resolution(o, run.downscale);
     const Dataset scene = load_dataset(o.scene, dopt);
+    check_run_scene(o.run, scene);
     if (!o.quiet)
         std::printf("eval: %zu surfels from %s; %zu test images of %s at 1/%d, config %s, %d angles each\n",
                     run.model.size(), o.run.c_str(), config.images.size(), o.scene.c_str(), dopt.downscale,
@@ -196,6 +199,7 @@ void run_holdout(const EvalOptions& o) {
     const TrainedRun run = load_run_or_ply(o.run);
     const DatasetOptions dopt = evaluated_resolution(o, run.downscale);
     const Dataset scene = load_dataset(o.scene, dopt);
+    check_run_scene(o.run, scene);
     HoldoutOptions hopt;
     hopt.views = o.views == "train" ? Split::Train : Split::Test;
     hopt.keep_panels = !o.no_sheets;
@@ -233,11 +237,12 @@ void run_holdout(const EvalOptions& o) {
                 seconds_since(t0));
 }
 
-void run_eval(const EvalOptions& o) {
+void run_eval(EvalOptions o) {
     std::unique_ptr<tbb::global_control> threads;
     if (o.threads > 0)
         threads =
             std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, o.threads);
+    o.scene = scene_for_run(o.run, o.scene, "eval needs the scene");
     if (o.protocol == "sol-nerf")
         run_sol_nerf(o);
     else if (o.protocol == "holdout")
@@ -256,10 +261,11 @@ void register_eval(CLI::App& app) {
                     "bare relightable PLY (the official LumiGauss layout)")
         ->required();
     cmd->add_option(
-           "--scene", o->scene,
-           "the scene: for gt-env with ground truth (meta.json, env/COND_sh.txt, gt/); for sol-nerf a "
-           "NeRF-OSR scene (COLMAP layout as on Zenodo, or NeRF-OSR's final/ layout)")
-        ->required();
+        "--scene", o->scene,
+        "the scene: for gt-env with ground truth (meta.json, env/COND_sh.txt, gt/); for sol-nerf a "
+        "NeRF-OSR scene (COLMAP layout as on Zenodo, or NeRF-OSR's final/ layout). Default: the scene "
+        "the run was trained on (RUN/scene.json); a scene whose photos of the same names have other "
+        "cameras is refused");
     cmd->add_option("--protocol", o->protocol,
                     "gt-env: render each test photo under its true environment SH, scaled by the one "
                     "light scale fitted on the training photos; sol-nerf: the paper's NeRF-OSR protocol "

@@ -156,8 +156,9 @@ void register_render(CLI::App& app) {
     cmd->add_option("--ply", o->ply, "surfel model in the 2DGS PLY layout (instead of a run)")
         ->check(CLI::ExistingFile);
     cmd->add_option("--scene", o->scene,
-                    "scene folder (COLMAP or NeRF-OSR layout): its cameras; needed for --ply and for "
-                    "--cameras train|test|validation|all|orbit");
+                    "scene folder (COLMAP or NeRF-OSR layout): its cameras; needed for --ply, and for a run "
+                    "with --cameras train|test|validation|all|orbit unless the run recorded its scene "
+                    "(RUN/scene.json; a scene whose photos of the same names have other cameras is refused)");
     cmd->add_option("-o,--output", o->out, "output folder")->capture_default_str();
     cmd->add_option("-r,--downscale", o->downscale,
                     "downscale images by 1, 2, 4 or 8 (default: 1 for --ply, the run's training "

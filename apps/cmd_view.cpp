@@ -4,6 +4,7 @@
 // file, environment rotation, shadowed/unshadowed/albedo/normals/shadow views (src/lumigauss/viewer/).
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 
@@ -11,6 +12,8 @@
 #include "lumigauss/cameras/camera_json.h"
 #include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/io/dataset.h"
+#include "lumigauss/model/run_files.h"
+#include "lumigauss/model/scene_record.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_source.h"
 #include "lumigauss/util/error.h"
@@ -60,14 +63,25 @@ class StopSignals {
     struct sigaction old_term_ = {};
 };
 
+// --scene, else the scene the run recorded (RUN/scene.json) if it is still there, else none: the viewer
+// works without one.
+std::string scene_to_open(const ViewOptions& o) {
+    if (!o.scene.empty()) return o.scene;
+    const std::optional<SceneRecord> record = load_scene_record(run_paths(o.source).scene);
+    std::error_code ec;
+    if (!record || !std::filesystem::is_directory(record->scene, ec)) return {};
+    return record->scene;
+}
+
 // The cameras "auto" estimates the up axis from, the initial one first: --camera (its first entry) wins over
-// --scene (its first training view).
+// the scene (its first training view).
 std::vector<Camera> known_cameras(const ViewOptions& o) {
     std::vector<Camera> cams;
     if (!o.camera_json.empty())
         for (const NamedCamera& c : read_camera_json(o.camera_json)) cams.push_back(c.camera);
-    if (!o.scene.empty()) {
-        const Dataset scene = load_dataset(o.scene);
+    if (const std::string dir = scene_to_open(o); !dir.empty()) {
+        const Dataset scene = load_dataset(dir);
+        check_run_scene(o.source, scene);
         const std::vector<const View*> train = scene.split(Split::Train);
         if (!train.empty()) cams.push_back(train.front()->camera);
         for (const View& v : scene.views) cams.push_back(v.camera);
@@ -137,7 +151,8 @@ void register_view(CLI::App& app) {
                     "-z, or auto (from --scene/--camera)")
         ->capture_default_str();
     cmd->add_option("--scene", o->scene,
-                    "scene folder (COLMAP or NeRF-OSR): its first training view is the initial camera");
+                    "scene folder (COLMAP or NeRF-OSR): its first training view is the initial camera "
+                    "(default: the scene the run was trained on, RUN/scene.json, if it is still there)");
     cmd->add_option("--camera", o->camera_json,
                     "camera JSON (as for `render --cameras FILE`): its first camera is the initial view");
     // Hidden (empty group): for the browser test and bench/viewer_bench.sh.

@@ -324,6 +324,10 @@ TEST(CliRelight, BadInputNamesTheFileAndWritesNothing) {
     fs::create_directories(broken);
     for (const char* f : {"lighting.lgmlp", "appearance.json", "config.json"})
         fs::copy_file(t.run + "/" + f, broken + "/" + f);
+    // A run from before runs recorded their scene: scene cameras need --scene.
+    const std::string unrecorded = tmp / "unrecorded_run";
+    fs::copy(t.run, unrecorded, fs::copy_options::recursive);
+    fs::remove(unrecorded + "/scene.json");
     {
         std::ofstream bad(tmp / "bad.png");
         bad << "not an image";
@@ -347,8 +351,9 @@ TEST(CliRelight, BadInputNamesTheFileAndWritesNothing) {
         {base + "--light train_0000.png --cameras " + shell_quoted(tmp / "cams.json"),
          {"cams.json", "cameras[1]", "fx"}},
         {base + "--light train_0000.png --cameras nowhere.json", {"nowhere.json"}},
-        {"render " + shell_quoted(t.run) + " --light train_0000.png --cameras orbit -o " + shell_quoted(out),
-         {"--scene"}},
+        {"render " + shell_quoted(unrecorded) + " --light train_0000.png --cameras orbit -o " +
+             shell_quoted(out),
+         {"--scene", "scene.json"}},
         {base + "--light train_0000.png --view nope", {"nope", "test_0000"}},
         {base + "--light train_0000.png --up sideways", {"sideways"}},
         {base + "--light train_0000.png --outputs shadowed,colour", {"colour"}},

@@ -19,7 +19,8 @@ RunPaths run_paths(const std::string& dir) {
             (d / "model.ply").string(),
             (d / "lighting.lgmlp").string(),
             (d / "appearance.json").string(),
-            (d / "sky.lgsky").string()};
+            (d / "sky.lgsky").string(),
+            (d / "scene.json").string()};
 }
 
 void save_appearance(const std::string& path, const std::vector<std::string>& image_names) {

@@ -7,6 +7,7 @@
 //   lighting.lgmlp    the lighting MLP and embedding table (lighting_mlp.h)
 //   appearance.json   the photo names in embedding-table order: {"images": [{"name": ..., "index": i}]}
 //   sky.lgsky         the per-photo sky residuals (sky_residual.h), when the run trained them
+//   scene.json        the scene it was trained on: path and camera poses (scene_record.h)
 // Every file is written atomically (temp + rename).
 #include <string>
 #include <vector>
@@ -18,7 +19,7 @@
 namespace lumigauss {
 
 struct RunPaths {
-    std::string dir, config, log, checkpoint, model, lighting, appearance, sky;
+    std::string dir, config, log, checkpoint, model, lighting, appearance, sky, scene;
 };
 RunPaths run_paths(const std::string& dir);
 

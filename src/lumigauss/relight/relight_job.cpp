@@ -8,6 +8,7 @@
 #include "lumigauss/cameras/orbit.h"
 #include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/io/dataset.h"
+#include "lumigauss/model/scene_record.h"
 #include "lumigauss/relight/relit_render.h"
 #include "lumigauss/relight/relit_sky.h"
 #include "lumigauss/relight/video.h"
@@ -85,11 +86,13 @@ RelightCameras relight_cameras(const RelightJob& job, const TrainedRun& run) {
         rc.cameras = filter_views(std::move(rc.cameras), {}, job.views, job.cameras);
         return rc;
     }
-    if (job.scene.empty()) throw Error("--cameras " + job.cameras + " needs --scene (the scene's cameras)");
+    const std::string scene_dir =
+        scene_for_run(job.run, job.scene, "--cameras " + job.cameras + " needs the scene's cameras");
     DatasetOptions dopt;
     dopt.downscale = job.downscale > 0 ? job.downscale : (run.downscale > 0 ? run.downscale : 1);
-    const Dataset scene = load_dataset(job.scene, dopt);
-    if (scene.views.empty()) throw Error(job.scene + ": the scene has no view");
+    const Dataset scene = load_dataset(scene_dir, dopt);
+    if (scene.views.empty()) throw Error(scene_dir + ": the scene has no view");
+    check_run_scene(job.run, scene);
     std::vector<Camera> all;
     for (const View& v : scene.views) all.push_back(v.camera);
     rc.up = job.up == "auto" ? estimate_up_axis(all) : parse_up_axis(job.up);
@@ -110,10 +113,10 @@ RelightCameras relight_cameras(const RelightJob& job, const TrainedRun& run) {
         image_names.push_back(v.name);
     }
     if (rc.cameras.empty())
-        throw Error(job.scene + ": no view is in split '" + job.cameras +
+        throw Error(scene_dir + ": no view is in split '" + job.cameras +
                     "' (--cameras all renders every view)");
     rc.cameras = filter_views(std::move(rc.cameras), image_names, job.views,
-                              job.scene + " (split " + job.cameras + ")");
+                              scene_dir + " (split " + job.cameras + ")");
     return rc;
 }
 

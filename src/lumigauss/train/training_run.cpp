@@ -10,6 +10,7 @@
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/model/render_model.h"
+#include "lumigauss/model/scene_record.h"
 #include "lumigauss/render/background.h"
 #include "lumigauss/render/raster_maps.h"
 #include "lumigauss/shading/sky_image.h"
@@ -29,7 +30,7 @@ namespace {
 void remove_previous_run(const RunPaths& paths) {
     namespace fs = std::filesystem;
     for (const std::string* f :
-         {&paths.checkpoint, &paths.model, &paths.lighting, &paths.appearance, &paths.sky})
+         {&paths.checkpoint, &paths.model, &paths.lighting, &paths.appearance, &paths.sky, &paths.scene})
         fs::remove(*f);
     fs::remove_all(fs::path(paths.dir) / "previews");
 }
@@ -64,6 +65,8 @@ TrainingRun::TrainingRun(const TrainingRunRequest& request) : paths_(run_paths(r
         DatasetOptions dopt;
         dopt.downscale = state.config.downscale;
         const Dataset data = load_dataset(request.scene, dopt);
+        if (const auto record = load_scene_record(paths_.scene))
+            check_scene_matches(*record, paths_.scene, data);
         sfm_points_ = data.point_xyz.size();
         trainer_ = std::make_unique<Trainer>(load_train_views(data), std::move(state));
         truncate_log(paths_.log, trainer_->iteration());
@@ -84,6 +87,7 @@ TrainingRun::TrainingRun(const TrainingRunRequest& request) : paths_(run_paths(r
         std::filesystem::create_directories(request.out);  // only once the input is known to be good
         remove_previous_run(paths_);
         write_file_atomically(paths_.config, train_config_to_json(request.config));
+        save_scene_record(paths_.scene, scene_record_of(data));
         write_file_atomically(paths_.log, "");
     }
     trainer_->set_backend(request.backend);
