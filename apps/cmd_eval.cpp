@@ -57,8 +57,7 @@ void run_gt_env(const EvalOptions& o) {
     const GtSceneMeta meta = load_gt_scene_meta(o.scene);
     const RelightableRun run = load_relightable_run(o.run);
     const DatasetOptions dopt = evaluated_resolution(o, run.downscale);
-    const Dataset scene = load_dataset(o.scene, dopt);
-    check_run_scene(o.run, scene);
+    const Dataset scene = load_scene_of_run(o.run, o.scene, dopt);
     if (!o.quiet)
         std::printf("eval: %zu surfels, %zu training photos from %s; %zu %s views of %s at 1/%d\n",
                     run.model.size(), run.image_names.size(), o.run.c_str(),
@@ -167,8 +166,7 @@ void run_sol_nerf(const EvalOptions& o) {
     const SolNerfConfig config = load_sol_nerf_config(sol_config_path(o));
     const TrainedRun run = load_run_or_ply(o.run);
     const DatasetOptions dopt = evaluated_resolution(o, run.downscale);
-    const Dataset scene = load_dataset(o.scene, dopt);
-    check_run_scene(o.run, scene);
+    const Dataset scene = load_scene_of_run(o.run, o.scene, dopt);
     if (!o.quiet)
         std::printf("eval: %zu surfels from %s; %zu test images of %s at 1/%d, config %s, %d angles each\n",
                     run.model.size(), o.run.c_str(), config.images.size(), o.scene.c_str(), dopt.downscale,
@@ -198,8 +196,7 @@ void run_holdout(const EvalOptions& o) {
     const auto t0 = std::chrono::steady_clock::now();
     const TrainedRun run = load_run_or_ply(o.run);
     const DatasetOptions dopt = evaluated_resolution(o, run.downscale);
-    const Dataset scene = load_dataset(o.scene, dopt);
-    check_run_scene(o.run, scene);
+    const Dataset scene = load_scene_of_run(o.run, o.scene, dopt);
     HoldoutOptions hopt;
     hopt.views = o.views == "train" ? Split::Train : Split::Test;
     hopt.keep_panels = !o.no_sheets;

@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 
 #include "commands.h"
 #include "lumigauss/io/dataset.h"
@@ -37,7 +38,8 @@ struct TrainFlags {
     std::vector<std::string> overrides;
     std::int64_t iterations = 0, stop_after = 0;
     int downscale = 0, threads = 0;
-    bool resume = false, force = false, quiet = false;
+    std::optional<int> test_every;
+    bool resume = false, force = false, quiet = false, no_test = false;
 };
 
 double peak_memory_mib() {
@@ -115,11 +117,13 @@ int run_train(const TrainFlags& f) {
     request.scene = f.scene, request.out = f.out;
     request.resume = f.resume, request.force = f.force;
     if (f.resume) {
-        if (!f.config_file.empty() || !f.overrides.empty() || f.downscale > 0)
-            throw Error("--resume continues with the saved config; only --iterations may change");
+        if (!f.config_file.empty() || !f.overrides.empty() || f.downscale > 0 || f.test_every || f.no_test)
+            throw Error("--resume continues with the saved config and split; only --iterations may change");
         request.resume_iterations = f.iterations;
     } else {
         request.config = config_from_flags(f);
+        if (f.no_test) request.test_every = 0;
+        if (f.test_every) request.test_every = *f.test_every;
     }
     TrainingRun run(request);
     const Trainer& trainer = run.trainer();
@@ -129,9 +133,11 @@ int run_train(const TrainFlags& f) {
         std::printf("train: resuming %s at iteration %lld of %lld\n", f.out.c_str(),
                     (long long)trainer.iteration(), (long long)config.iterations);
     else
-        std::printf("train: %zu photos, %zu SfM points, preset %s, %lld iterations -> %s\n",
-                    trainer.views().size(), run.sfm_points(), config.preset.c_str(),
-                    (long long)config.iterations, f.out.c_str());
+        std::printf(
+            "train: %zu photos (%zu more held out for testing), %zu SfM points, preset %s, %lld "
+            "iterations -> %s\n",
+            trainer.views().size(), run.held_out_photos(), run.sfm_points(), config.preset.c_str(),
+            (long long)config.iterations, f.out.c_str());
     if (!run.resumed()) {
         std::printf("train: %s\n", schedule_summary(config).c_str());
         if (config.iterations <= config.start_shadowed)
@@ -207,6 +213,13 @@ void register_train(CLI::App& app) {
         ->check(CLI::IsMember({1, 2, 4, 8}));
     cmd->add_option("--config", f->config_file, "JSON file with config keys (see the run's config.json)");
     cmd->add_option("--set", f->overrides, "Override one config key: --set lambda_shadow=5 (repeatable)");
+    auto* every = cmd->add_option("--test-every", f->test_every,
+                                  "Every N-th photo by name is held out as a test photo, the others train, "
+                                  "whatever the scene's split file says (default: the split file, else every "
+                                  "8th). Recorded in the run: render and eval then use this split")
+                      ->check(CLI::PositiveNumber);
+    cmd->add_flag("--no-test", f->no_test, "Train on every photo, test photos of the split file included")
+        ->excludes(every);
     cmd->add_flag("--resume", f->resume, "Continue the run in the output folder from its checkpoint");
     cmd->add_flag("--force", f->force, "Replace an existing run in the output folder");
     cmd->add_option("--stop-after", f->stop_after, "Checkpoint and stop after this iteration (resume later)")

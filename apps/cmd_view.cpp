@@ -80,8 +80,7 @@ std::vector<Camera> known_cameras(const ViewOptions& o) {
     if (!o.camera_json.empty())
         for (const NamedCamera& c : read_camera_json(o.camera_json)) cams.push_back(c.camera);
     if (const std::string dir = scene_to_open(o); !dir.empty()) {
-        const Dataset scene = load_dataset(dir);
-        check_run_scene(o.source, scene);
+        const Dataset scene = load_scene_of_run(o.source, dir);
         const std::vector<const View*> train = scene.split(Split::Train);
         if (!train.empty()) cams.push_back(train.front()->camera);
         for (const View& v : scene.views) cams.push_back(v.camera);

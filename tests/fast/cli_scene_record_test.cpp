@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
@@ -129,6 +130,46 @@ TEST(CliSceneRecord, EvalAndRenderFindTheSceneAndRefuseAnother) {
     r = run_lumigauss("eval " + shell_quoted(run) + " -o " + shell_quoted(tmp / "eval3") + " -q", tmp);
     EXPECT_NE(r.exit_code, 0) << r.output;
     EXPECT_THAT(r.output, HasSubstr("no longer there; give --scene"));
+}
+
+// train --test-every / --no-test override the scene's split; the run records it, and eval scores the photos
+// this run held out (not those of the scene's split file).
+TEST(CliSceneRecord, SplitControlIsRecordedAndFollowedByEval) {
+    TempDir tmp("cli_split_control");
+    const std::string scene = tmp / "scene", run = tmp / "run", all = tmp / "all";
+    CommandResult r = run_lumigauss("synth --preset tiny -o " + shell_quoted(scene), tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const Dataset d = load_dataset(scene);
+    r = run_lumigauss("train " + shell_quoted(scene) + " -o " + shell_quoted(run) +
+                          " --preset fast --iterations 10 --test-every 2",
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const std::size_t held_out = (d.views.size() + 1) / 2;
+    EXPECT_THAT(r.output, HasSubstr(std::to_string(d.views.size() - held_out) + " photos (" +
+                                    std::to_string(held_out) + " more held out for testing)"));
+    const SceneRecord record = load_scene_record(run_paths(run).scene).value();
+    std::size_t recorded_test = 0;
+    for (const RecordedPhoto& p : record.photos) recorded_test += p.split == "test";
+    EXPECT_EQ(recorded_test, held_out);
+
+    r = run_lumigauss("eval " + shell_quoted(run) + " -o " + shell_quoted(tmp / "eval") + " --no-sheets",
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto metrics = nlohmann::json::parse(read_all(tmp / "eval/metrics.json"));
+    EXPECT_EQ(metrics["images"].size(), held_out) << "eval scored the scene's split, not the run's";
+
+    r = run_lumigauss("train " + shell_quoted(scene) + " -o " + shell_quoted(run) + " --resume --no-test",
+                      tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("saved config and split"));
+
+    r = run_lumigauss("train " + shell_quoted(scene) + " -o " + shell_quoted(all) +
+                          " --preset fast --iterations 10 --no-test -q",
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    r = run_lumigauss("eval " + shell_quoted(all) + " -o " + shell_quoted(tmp / "eval_all") + " -q", tmp);
+    EXPECT_NE(r.exit_code, 0) << "a run that trained on every photo has nothing to test on";
+    EXPECT_THAT(r.output, HasSubstr("no test image"));
 }
 
 }  // namespace

@@ -176,6 +176,22 @@ TEST(DatasetColmap, HoldoutEveryEighthImageWithoutSplitFile) {
     EXPECT_EQ(load_dataset(tmp.path().string(), {.holdout_every = 0}).split(Split::Test).size(), 0u);
 }
 
+// train --test-every N / --no-test: the override wins over a split file.
+TEST(DatasetColmap, TestEveryOverridesTheSplitFile) {
+    TempDir tmp;
+    test::write_scene(tmp.path(), test::small_model(10, 8, 6));
+    std::string split = "filename;split\n";
+    for (int i = 0; i < 10; ++i)
+        split += "img_" + std::to_string(i) + ".png;" + (i < 5 ? "test" : "train") + "\n";
+    test::write_text(tmp / "split.csv", split);
+    EXPECT_EQ(load_dataset(tmp.path().string()).split(Split::Test).size(), 5u);
+    const Dataset every3 = load_dataset(tmp.path().string(), {.test_every = 3});
+    ASSERT_EQ(every3.split(Split::Test).size(), 4u);  // img_0, img_3, img_6, img_9
+    EXPECT_EQ(every3.split(Split::Test)[1]->name, "img_3.png");
+    EXPECT_EQ(load_dataset(tmp.path().string(), {.test_every = 0}).split(Split::Train).size(), 10u);
+    EXPECT_THROW(load_dataset(tmp.path().string(), {.test_every = -1}), Error);
+}
+
 TEST(DatasetColmap, PoseAndIntrinsicsFromModel) {
     TempDir tmp;
     ColmapModel m = test::small_model(2, 8, 6);

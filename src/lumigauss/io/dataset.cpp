@@ -146,6 +146,12 @@ Dataset load_dataset(const std::string& root, const DatasetOptions& options) {
                      ".bin or .txt, and images/) or a NeRF-OSR layout (final/{train,validation,test}/rgb/)");
     std::sort(raw.views.begin(), raw.views.end(),
               [](const RawView& a, const RawView& b) { return a.view.name < b.view.name; });
+    if (options.test_every) {
+        if (*options.test_every < 0) throw Error("--test-every must be 0 (no test photo) or more");
+        const auto n = std::size_t(*options.test_every);
+        for (std::size_t i = 0; i < raw.views.size(); ++i)
+            raw.views[i].view.split = n > 0 && i % n == 0 ? Split::Test : Split::Train;
+    }
     check_unique_names(raw.views);
     Dataset d;
     d.root = root;

@@ -15,6 +15,7 @@
 // Downscaling by a factor f: a W x H image becomes floor(W/f) x floor(H/f) (at least 1), by area averaging of
 // the whole source extent onto the whole target extent (resize_area), and the camera is Camera::resized to
 // that size, so intrinsics scale by floor(W/f)/W and floor(H/f)/H -- exactly 1/f when f divides the size.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,9 @@ struct DatasetOptions {
     int downscale = 1;  // 1, 2, 4 or 8
     // Without a split file every n-th image (sorted by name, the first included) is a test image; 0: none.
     int holdout_every = 8;
+    // Set (train --test-every N, --no-test): every n-th image by name is a test image and the others train
+    // (0: every image trains), whatever the split file or the NeRF-OSR folders say.
+    std::optional<int> test_every = std::nullopt;
 };
 
 enum class Split { Train, Test, Validation };

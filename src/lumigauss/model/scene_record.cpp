@@ -107,10 +107,30 @@ void check_scene_matches(const SceneRecord& record, const std::string& record_pa
     }
 }
 
-void check_run_scene(const std::string& run_dir, const Dataset& scene) {
+void apply_recorded_splits(const SceneRecord& record, Dataset& scene) {
+    std::map<std::string, std::string> split_of;
+    for (const RecordedPhoto& p : record.photos) split_of[p.name] = p.split;
+    for (View& v : scene.views) {
+        const auto it = split_of.find(v.name);
+        if (it == split_of.end()) continue;
+        for (Split s : {Split::Train, Split::Test, Split::Validation})
+            if (it->second == split_name(s)) v.split = s;
+    }
+}
+
+void adopt_run_scene(const std::string& run_dir, Dataset& scene) {
     const std::string record_path = run_paths(run_dir).scene;
-    if (const std::optional<SceneRecord> record = load_scene_record(record_path))
+    if (const std::optional<SceneRecord> record = load_scene_record(record_path)) {
         check_scene_matches(*record, record_path, scene);
+        apply_recorded_splits(*record, scene);
+    }
+}
+
+Dataset load_scene_of_run(const std::string& run_dir, const std::string& scene_dir,
+                          const DatasetOptions& options) {
+    Dataset scene = load_dataset(scene_dir, options);
+    adopt_run_scene(run_dir, scene);
+    return scene;
 }
 
 std::string scene_for_run(const std::string& run_dir, const std::string& given, const std::string& why) {

@@ -45,9 +45,18 @@ std::optional<SceneRecord> load_scene_record(const std::string& path);
 // one side has are fine (new photos of the place, or a scene with fewer of them).
 void check_scene_matches(const SceneRecord& record, const std::string& record_path, const Dataset& scene);
 
-// check_scene_matches against the scene.json of the run folder `run_dir`, when it has one (a bare PLY or a
-// run from before scene.json has none: nothing to check).
-void check_run_scene(const std::string& run_dir, const Dataset& scene);
+// Gives each photo of `scene` that the record names the split it had in training (train --test-every and
+// --no-test change them): "test" then means "held out from this run", whatever the scene's split file says.
+void apply_recorded_splits(const SceneRecord& record, Dataset& scene);
+
+// For a scene loaded to work on the run folder `run_dir`: check_scene_matches and apply_recorded_splits
+// against its scene.json, when it has one (a bare PLY or a run from before scene.json has none: the scene
+// is taken as it is).
+void adopt_run_scene(const std::string& run_dir, Dataset& scene);
+
+// load_dataset(scene_dir, options), then adopt_run_scene(run_dir, ...).
+Dataset load_scene_of_run(const std::string& run_dir, const std::string& scene_dir,
+                          const DatasetOptions& options = {});
 
 // The scene folder for a command on the run folder `run_dir`: `given` when not empty, else the one its
 // scene.json records. Throws Error saying `why` the scene is needed when there is neither, or when the

@@ -90,9 +90,8 @@ RelightCameras relight_cameras(const RelightJob& job, const TrainedRun& run) {
         scene_for_run(job.run, job.scene, "--cameras " + job.cameras + " needs the scene's cameras");
     DatasetOptions dopt;
     dopt.downscale = job.downscale > 0 ? job.downscale : (run.downscale > 0 ? run.downscale : 1);
-    const Dataset scene = load_dataset(scene_dir, dopt);
+    const Dataset scene = load_scene_of_run(job.run, scene_dir, dopt);
     if (scene.views.empty()) throw Error(scene_dir + ": the scene has no view");
-    check_run_scene(job.run, scene);
     std::vector<Camera> all;
     for (const View& v : scene.views) all.push_back(v.camera);
     rc.up = job.up == "auto" ? estimate_up_axis(all) : parse_up_axis(job.up);

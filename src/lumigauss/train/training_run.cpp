@@ -64,10 +64,9 @@ TrainingRun::TrainingRun(const TrainingRunRequest& request) : paths_(run_paths(r
         }
         DatasetOptions dopt;
         dopt.downscale = state.config.downscale;
-        const Dataset data = load_dataset(request.scene, dopt);
-        if (const auto record = load_scene_record(paths_.scene))
-            check_scene_matches(*record, paths_.scene, data);
+        const Dataset data = load_scene_of_run(request.out, request.scene, dopt);  // its poses and split
         sfm_points_ = data.point_xyz.size();
+        held_out_photos_ = data.views.size() - data.split(Split::Train).size();
         trainer_ = std::make_unique<Trainer>(load_train_views(data), std::move(state));
         truncate_log(paths_.log, trainer_->iteration());
         resumed_ = true;
@@ -77,9 +76,11 @@ TrainingRun::TrainingRun(const TrainingRunRequest& request) : paths_(run_paths(r
                          "a run already exists here; continue it with --resume or replace it with --force");
         DatasetOptions dopt;
         dopt.downscale = request.config.downscale;
+        dopt.test_every = request.test_every;
         const Dataset data = load_dataset(request.scene, dopt);
         if (data.point_xyz.empty()) fail_without_points(data);
         sfm_points_ = data.point_xyz.size();
+        held_out_photos_ = data.views.size() - data.split(Split::Train).size();
         far_points_dropped_ = data.far_points_dropped;
         far_point_limit_ = data.far_point_limit;
         trainer_ =

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "lumigauss/model/run_files.h"
@@ -24,6 +25,9 @@ struct TrainingRunRequest {
     TrainConfig config;                  // a new run's configuration (a resumed run keeps its own)
     std::int64_t resume_iterations = 0;  // resume only: > 0 sets a new total (not below the checkpoint's)
     RasterBackend backend = RasterBackend::Cpu;
+    // A new run's split override (DatasetOptions::test_every): set, every n-th photo is a test photo (0:
+    // none). A resumed run keeps the split it recorded (scene.json).
+    std::optional<int> test_every;
 };
 
 enum class TrainingOutcome {
@@ -49,6 +53,7 @@ class TrainingRun {
     const RunPaths& paths() const { return paths_; }
     bool resumed() const { return resumed_; }
     std::size_t sfm_points() const { return sfm_points_; }
+    std::size_t held_out_photos() const { return held_out_photos_; }  // the scene's test/validation photos
     // SfM points the dataset dropped for lying absurdly far from the cameras, and beyond what distance.
     std::size_t far_points_dropped() const { return far_points_dropped_; }
     double far_point_limit() const { return far_point_limit_; }
@@ -62,7 +67,7 @@ class TrainingRun {
     RunPaths paths_;
     std::unique_ptr<Trainer> trainer_;
     bool resumed_ = false;
-    std::size_t sfm_points_ = 0;
+    std::size_t sfm_points_ = 0, held_out_photos_ = 0;
     std::size_t far_points_dropped_ = 0;
     double far_point_limit_ = 0;
     std::string failure_;
