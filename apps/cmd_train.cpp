@@ -37,7 +37,8 @@ struct TrainFlags {
     std::string scene, out, preset = "default", config_file, backend = "cpu";
     std::vector<std::string> overrides;
     std::int64_t iterations = 0, stop_after = 0;
-    int downscale = 0, threads = 0;
+    std::string downscale;  // -r: "auto", 1, 2, 4, 8; empty: the preset's (auto)
+    int threads = 0;
     std::optional<int> test_every;
     bool resume = false, force = false, quiet = false, no_test = false;
 };
@@ -55,7 +56,7 @@ TrainConfig config_from_flags(const TrainFlags& f) {
     // as given, after it.
     if (f.iterations > 0) scale_schedule(c, f.iterations);
     for (const auto& o : f.overrides) apply_train_config_override(c, o);
-    if (f.downscale > 0) c.downscale = f.downscale;
+    if (!f.downscale.empty()) c.downscale = f.downscale == "auto" ? 0 : std::stoi(f.downscale);
     validate_train_config(c);
     return c;
 }
@@ -117,7 +118,8 @@ int run_train(const TrainFlags& f) {
     request.scene = f.scene, request.out = f.out;
     request.resume = f.resume, request.force = f.force;
     if (f.resume) {
-        if (!f.config_file.empty() || !f.overrides.empty() || f.downscale > 0 || f.test_every || f.no_test)
+        if (!f.config_file.empty() || !f.overrides.empty() || !f.downscale.empty() || f.test_every ||
+            f.no_test)
             throw Error("--resume continues with the saved config and split; only --iterations may change");
         request.resume_iterations = f.iterations;
     } else {
@@ -138,6 +140,7 @@ int run_train(const TrainFlags& f) {
             "iterations -> %s\n",
             trainer.views().size(), run.held_out_photos(), run.sfm_points(), config.preset.c_str(),
             (long long)config.iterations, f.out.c_str());
+    if (!run.auto_downscale_note().empty()) std::printf("train: %s\n", run.auto_downscale_note().c_str());
     if (!run.resumed()) {
         std::printf("train: %s\n", schedule_summary(config).c_str());
         if (config.iterations <= config.start_shadowed)
@@ -209,8 +212,10 @@ void register_train(CLI::App& app) {
                     "Total iterations; the preset's schedule (stages, densification, resets) scales with it "
                     "(with --resume: only extends the run)")
         ->check(CLI::PositiveNumber);
-    cmd->add_option("-r,--resolution", f->downscale, "Downscale the photos by 1, 2, 4 or 8")
-        ->check(CLI::IsMember({1, 2, 4, 8}));
+    cmd->add_option("-r,--resolution", f->downscale,
+                    "Downscale the photos by 1, 2, 4 or 8; auto (the default) takes the smallest factor that "
+                    "brings the longest photo side to at most 1600 px, and says so")
+        ->check(CLI::IsMember({"auto", "1", "2", "4", "8"}));
     cmd->add_option("--config", f->config_file, "JSON file with config keys (see the run's config.json)");
     cmd->add_option("--set", f->overrides, "Override one config key: --set lambda_shadow=5 (repeatable)");
     auto* every = cmd->add_option("--test-every", f->test_every,

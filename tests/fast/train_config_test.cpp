@@ -229,8 +229,8 @@ TEST(TrainConfigPreset, PaperFastShrinksTheScheduleOnly) {
 // The default presets are the paper's (and paper-fast's) plus the improvements of issue #25, each a key.
 TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
     const std::set<std::string> improvements = {
-        "init_normals_from_points", "sky_background",  "lambda_sky_alpha",     "sky_free_regularizers",
-        "lambda_background_alpha",  "prune_until_end", "densify_near_fraction"};
+        "init_normals_from_points", "sky_background",  "lambda_sky_alpha",      "sky_free_regularizers",
+        "lambda_background_alpha",  "prune_until_end", "densify_near_fraction", "downscale"};
     for (const auto& [improved, base] : {std::pair{"default", "paper"}, std::pair{"fast", "paper-fast"}}) {
         SCOPED_TRACE(improved);
         const Json a = Json::parse(train_config_to_json(train_preset(improved)));
@@ -589,7 +589,7 @@ TEST(TrainConfigValidate, RejectsEachBadValueNamingTheKey) {
         {"warmup", [](TrainConfig& c) { c.warmup = c.start_shadowed + 1; }},
         {"start_regularization", [](TrainConfig& c) { c.start_regularization = -1; }},
         {"downscale", [](TrainConfig& c) { c.downscale = 3; }},
-        {"downscale", [](TrainConfig& c) { c.downscale = 0; }},
+        {"downscale", [](TrainConfig& c) { c.downscale = -1; }},
         {"downscale", [](TrainConfig& c) { c.downscale = 16; }},
         {"transfer_samples", [](TrainConfig& c) { c.transfer_samples = 0; }},
         {"env_samples", [](TrainConfig& c) { c.env_samples = -2; }},

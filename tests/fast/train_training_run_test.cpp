@@ -6,7 +6,9 @@
 #include <fstream>
 #include <string>
 
+#include "fast/io_test_util.h"
 #include "lumigauss/io/dataset.h"
+#include "lumigauss/io/text_file.h"
 #include "lumigauss/io/ply.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/synth/synth.h"
@@ -103,6 +105,31 @@ TEST(TrainingRun, ANerfOsrSceneTrainsFromItsPointCloud) {
     EXPECT_EQ(run.run(
                   0, [] { return false; }, [](const StepReport&) {}),
               TrainingOutcome::Finished);
+}
+
+// -r auto (downscale 0, every preset's default) trains large photos at the smallest of 1/2/4/8 that brings
+// the longest side to at most 1600 px, records the factor, and says so; an explicit factor is kept.
+TEST(TrainingRun, AutoResolutionDownscalesLargePhotos) {
+    TempDir tmp("training_run_auto_resolution");
+    test::write_scene(tmp / "scene", test::small_model(3, 3300, 24));  // 3300 px wide: 1/4 -> 825
+    TrainingRunRequest r = request(tmp / "run", 2);
+    r.scene = tmp / "scene";
+    ASSERT_EQ(r.config.downscale, 0) << "presets default to auto";
+    {
+        TrainingRun run(r);
+        EXPECT_EQ(run.trainer().state().config.downscale, 4);
+        EXPECT_EQ(run.trainer().views().front().camera.width, 825);
+        EXPECT_NE(run.auto_downscale_note().find("1/4"), std::string::npos) << run.auto_downscale_note();
+    }
+    EXPECT_NE(read_text_file(run_paths(r.out).config).find("\"downscale\": 4"), std::string::npos);
+    r.config.downscale = 1;
+    r.force = true;
+    TrainingRun full(r);
+    EXPECT_EQ(full.trainer().views().front().camera.width, 3300);
+    EXPECT_TRUE(full.auto_downscale_note().empty());
+    r.scene = tiny_scene();
+    r.config.downscale = 0;
+    EXPECT_TRUE(TrainingRun(r).auto_downscale_note().empty()) << "small photos stay at full size";
 }
 
 TEST(TrainingRun, ForceRemovesThePreviousRunBeforeTheNewOneCheckpoints) {

@@ -383,6 +383,7 @@ void add_improvements(TrainConfig& config) {
     config.lambda_background_alpha = 0.1;
     config.prune_until_end = true;
     config.densify_near_fraction = 0.37;  // Pixel-GS's value; -5 deg of test-view normal error on plaza
+    config.downscale = 0;                 // -r auto: large photos at most 1600 px (run_all.sh's -r 1 is off)
 }
 
 }  // namespace
@@ -497,8 +498,8 @@ void validate_train_config(const TrainConfig& c) {
         }
     }
 
-    require(c.downscale == 1 || c.downscale == 2 || c.downscale == 4 || c.downscale == 8, "downscale",
-            c.downscale, "must be 1, 2, 4 or 8");
+    require(c.downscale == 0 || c.downscale == 1 || c.downscale == 2 || c.downscale == 4 || c.downscale == 8,
+            "downscale", c.downscale, "must be 0 (auto), 1, 2, 4 or 8");
 
     // Schedule. start_shadowed > iterations (no stage 3) and warmup > iterations (stage 1 only) are allowed.
     require(c.iterations > 0, "iterations", c.iterations, "must be > 0");

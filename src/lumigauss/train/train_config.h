@@ -15,10 +15,16 @@
 
 namespace lumigauss {
 
+// The longest photo side -r auto trains at (downscale 0).
+inline constexpr int kAutoMaxPhotoSide = 1600;
+
 struct TrainConfig {
     std::string preset = "paper";
     std::uint64_t seed = 0;
-    int downscale = 1;  // -r: 1, 2, 4 or 8 (run_all.sh uses 1 on NeRF-OSR)
+    // -r: 1, 2, 4 or 8 (run_all.sh uses 1 on NeRF-OSR), or 0 = auto (the default presets): a new run takes
+    // the smallest of them that brings the longest photo side to at most kAutoMaxPhotoSide (3DGS's loader
+    // rescales photos wider than 1.6k px likewise when no -r is given) and records the factor it chose.
+    int downscale = 1;
 
     // Schedule (5).
     std::int64_t iterations = 40000;
@@ -144,7 +150,7 @@ void scale_schedule(TrainConfig& config, std::int64_t iterations);
 std::string schedule_summary(const TrainConfig& config);
 
 // Checks consistency (iterations > 0, warmup <= start_shadowed, sample counts > 0, non-negative weights and
-// rates, downscale in {1, 2, 4, 8}, ...); throws Error naming the offending key.
+// rates, downscale in {0 (auto), 1, 2, 4, 8}, ...); throws Error naming the offending key.
 void validate_train_config(const TrainConfig& config);
 
 }  // namespace lumigauss

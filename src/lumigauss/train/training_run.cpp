@@ -35,6 +35,20 @@ void remove_previous_run(const RunPaths& paths) {
     fs::remove_all(fs::path(paths.dir) / "previews");
 }
 
+// -r auto: the smallest factor of 1, 2, 4, 8 that brings the longest photo side to kAutoMaxPhotoSide (8 if
+// none does); `note` says what was chosen when it is not 1.
+int auto_downscale(const Dataset& data, std::string& note) {
+    int longest = 0;
+    for (const View& v : data.views) longest = std::max({longest, v.camera.width, v.camera.height});
+    int factor = 1;
+    while (factor < 8 && longest > factor * kAutoMaxPhotoSide) factor *= 2;
+    if (factor > 1)
+        note = "photos up to " + std::to_string(longest) + " px on their longest side: training at 1/" +
+               std::to_string(factor) + " resolution (-r auto keeps the longest side at most " +
+               std::to_string(kAutoMaxPhotoSide) + " px; -r 1 trains at full size)";
+    return factor;
+}
+
 // Training starts from SfM points; a scene without any says where they were looked for.
 [[noreturn]] void fail_without_points(const Dataset& data) {
     if (data.format == "nerf-osr")
@@ -74,20 +88,24 @@ TrainingRun::TrainingRun(const TrainingRunRequest& request) : paths_(run_paths(r
         if (std::filesystem::exists(paths_.checkpoint) && !request.force)
             fail_in_file(paths_.checkpoint,
                          "a run already exists here; continue it with --resume or replace it with --force");
+        TrainConfig config = request.config;
         DatasetOptions dopt;
-        dopt.downscale = request.config.downscale;
         dopt.test_every = request.test_every;
+        if (config.downscale == 0) {  // auto: from the photos' sizes (headers only; pixels load lazily)
+            dopt.downscale = 1;
+            config.downscale = auto_downscale(load_dataset(request.scene, dopt), auto_note_);
+        }
+        dopt.downscale = config.downscale;
         const Dataset data = load_dataset(request.scene, dopt);
         if (data.point_xyz.empty()) fail_without_points(data);
         sfm_points_ = data.point_xyz.size();
         held_out_photos_ = data.views.size() - data.split(Split::Train).size();
         far_points_dropped_ = data.far_points_dropped;
         far_point_limit_ = data.far_point_limit;
-        trainer_ =
-            std::make_unique<Trainer>(load_train_views(data), data.point_xyz, data.point_rgb, request.config);
+        trainer_ = std::make_unique<Trainer>(load_train_views(data), data.point_xyz, data.point_rgb, config);
         std::filesystem::create_directories(request.out);  // only once the input is known to be good
         remove_previous_run(paths_);
-        write_file_atomically(paths_.config, train_config_to_json(request.config));
+        write_file_atomically(paths_.config, train_config_to_json(config));
         save_scene_record(paths_.scene, scene_record_of(data));
         write_file_atomically(paths_.log, "");
     }

@@ -54,6 +54,8 @@ class TrainingRun {
     bool resumed() const { return resumed_; }
     std::size_t sfm_points() const { return sfm_points_; }
     std::size_t held_out_photos() const { return held_out_photos_; }  // the scene's test/validation photos
+    // What -r auto chose, when it downscaled the photos (empty otherwise).
+    const std::string& auto_downscale_note() const { return auto_note_; }
     // SfM points the dataset dropped for lying absurdly far from the cameras, and beyond what distance.
     std::size_t far_points_dropped() const { return far_points_dropped_; }
     double far_point_limit() const { return far_point_limit_; }
@@ -68,6 +70,7 @@ class TrainingRun {
     std::unique_ptr<Trainer> trainer_;
     bool resumed_ = false;
     std::size_t sfm_points_ = 0, held_out_photos_ = 0;
+    std::string auto_note_;
     std::size_t far_points_dropped_ = 0;
     double far_point_limit_ = 0;
     std::string failure_;
