@@ -211,15 +211,18 @@ void run_holdout(const EvalOptions& o) {
             "via the %s (%d iterations), scored on the right half\n",
             run.model.size(), o.run.c_str(), scene.split(hopt.views).size(), o.views.c_str(), o.scene.c_str(),
             dopt.downscale, light_variable_name(hopt.fit.variable), hopt.fit.iterations);
+    if (!o.quiet)
+        hopt.on_image = [&](const HoldoutImageResult& im, std::size_t done, std::size_t total) {
+            std::printf(
+                "  [%zu/%zu %.0f s] %-28s fit PSNR %6.2f/%6.2f | shadowed PSNR %6.2f SSIM %.4f | unshadowed "
+                "PSNR %6.2f SSIM %.4f\n",
+                done, total, seconds_since(t0), im.name.c_str(), im.fit_psnr, im.fit_psnr_unshadowed,
+                im.shadowed.psnr, im.shadowed.ssim, im.unshadowed.psnr, im.unshadowed.ssim);
+            std::fflush(stdout);
+        };
     const HoldoutResult result = evaluate_holdout(run, scene, hopt);
     write_holdout_report(o.out, result, {o.run, o.scene}, dopt.downscale, !o.no_sheets);
     if (!o.quiet) {
-        for (const HoldoutImageResult& im : result.images)
-            std::printf(
-                "  %-28s fit PSNR %6.2f/%6.2f | shadowed PSNR %6.2f SSIM %.4f | unshadowed PSNR %6.2f SSIM "
-                "%.4f\n",
-                im.name.c_str(), im.fit_psnr, im.fit_psnr_unshadowed, im.shadowed.psnr, im.shadowed.ssim,
-                im.unshadowed.psnr, im.unshadowed.ssim);
         std::printf("  mean: shadowed PSNR %.2f SSIM %.4f | unshadowed PSNR %.2f SSIM %.4f (fit %.2f dB)\n",
                     result.mean_shadowed.psnr, result.mean_shadowed.ssim, result.mean_unshadowed.psnr,
                     result.mean_unshadowed.ssim, result.mean_fit_psnr);

@@ -145,6 +145,10 @@ TEST(Holdout, CliWritesTheReport) {
     const std::vector<const View*> tests = d.split(Split::Test);
     ASSERT_EQ(m["images"].size(), tests.size());
     EXPECT_GT(m["mean"]["shadowed"]["psnr"].get<double>(), 30.0);
+    // Progress: one line per photo as its fit ends (a collection takes minutes).
+    const std::string last = "[" + std::to_string(tests.size()) + "/" + std::to_string(tests.size()) + " ";
+    EXPECT_NE(r.output.find("[1/" + std::to_string(tests.size()) + " "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(last), std::string::npos) << r.output;
     for (const View* v : tests) {
         fs::path stem = fs::path(v->name);
         stem.replace_extension();

@@ -114,6 +114,7 @@ HoldoutResult evaluate_holdout(const TrainedRun& run, const Dataset& scene, cons
     std::vector<double> fit_ms, render_ms;
     for (const View* v : views) {
         result.images.push_back(evaluate_view(run, scene, *v, renderer, options));
+        if (options.on_image) options.on_image(result.images.back(), result.images.size(), views.size());
         const HoldoutImageResult& r = result.images.back();
         add_metrics(result.mean_shadowed, r.shadowed);
         add_metrics(result.mean_unshadowed, r.unshadowed);

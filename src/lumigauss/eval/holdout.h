@@ -12,6 +12,7 @@
 // Each render is scored under its own fit: the shadowed render under the light fitted to the shadowed render,
 // the unshadowed one under the light fitted to the unshadowed render, so that neither is judged with a
 // light tuned for the other (an unshadowed model compensates missing shadows with a dimmer light).
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -26,12 +27,17 @@
 
 namespace lumigauss {
 
+struct HoldoutImageResult;
+
 struct HoldoutOptions {
     LightFitOptions fit;  // variable, iterations, ... (`shadowed` is set per fit)
     SsimOptions ssim;     // win 5, as the official evaluation
     Split views = Split::Test;
     bool keep_panels = true;
     RasterBackend backend = RasterBackend::Cpu;  // the scoring renders (the fits run on the CPU)
+    // Called after each photo (its result, how many are done, how many in all): each fit takes seconds, a
+    // collection minutes, so the command shows them as they come.
+    std::function<void(const HoldoutImageResult&, std::size_t done, std::size_t total)> on_image;
 };
 
 struct HoldoutImageResult {
