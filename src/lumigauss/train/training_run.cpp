@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
+#include <vector>
 
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/io/dataset.h"
@@ -16,6 +19,7 @@
 #include "lumigauss/shading/sky_image.h"
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/train/checkpoint.h"
+#include "lumigauss/train/progress_report.h"
 #include "lumigauss/train/run_folder.h"
 #include "lumigauss/util/error.h"
 #include "lumigauss/util/text.h"
@@ -23,6 +27,9 @@
 namespace lumigauss {
 
 namespace {
+
+// The training photos shown in previews/ and progress/.
+constexpr int kPreviewViews = 4;
 
 // What a replaced run (--force) leaves must not outlive it: a crash before the new run's first checkpoint
 // followed by --resume would otherwise continue the old run under the new config. Only the run's own files
@@ -33,6 +40,8 @@ void remove_previous_run(const RunPaths& paths) {
          {&paths.checkpoint, &paths.model, &paths.lighting, &paths.appearance, &paths.sky, &paths.scene})
         fs::remove(*f);
     fs::remove_all(fs::path(paths.dir) / "previews");
+    fs::remove_all(fs::path(paths.dir) / "progress");
+    fs::remove(fs::path(paths.dir) / "progress.html");
 }
 
 // -r auto: the smallest factor of 1, 2, 4, 8 that brings the longest photo side to kAutoMaxPhotoSide (8 if
@@ -119,6 +128,7 @@ TrainingRun::~TrainingRun() = default;
 void TrainingRun::save_checkpoint_and_snapshot() {
     save_checkpoint(paths_.checkpoint, trainer_->state());
     save_run_model(paths_, trainer_->state());
+    write_progress(paths_, *trainer_, kPreviewViews);
 }
 
 double TrainingRun::elapsed_seconds() const {
@@ -157,7 +167,8 @@ TrainingOutcome TrainingRun::run(std::int64_t stop_after, const std::function<bo
     }
     save_checkpoint(paths_.checkpoint, trainer_->state());
     save_run_model(paths_, trainer_->state());
-    write_previews((std::filesystem::path(paths_.dir) / "previews").string(), *trainer_, 4);
+    write_previews((std::filesystem::path(paths_.dir) / "previews").string(), *trainer_, kPreviewViews);
+    write_progress(paths_, *trainer_, kPreviewViews);
     elapsed_ = elapsed();
     return TrainingOutcome::Finished;
 }
@@ -177,37 +188,95 @@ void truncate_log(const std::string& path, std::int64_t iteration) {
     write_file_atomically(path, kept);
 }
 
+namespace {
+
+// Photo | shadowed | unshadowed of training view v under its learned light (over its sky when trained so).
+Image preview_image(const Trainer& trainer, int v) {
+    const TrainView& view = trainer.views()[std::size_t(v)];
+    const TrainState& st = trainer.state();
+    const ShCoeffs<float> env = st.lighting.env_sh(v);
+    RasterImages<float> img = render_with_environment(st.model, view.camera, env, ShadingMode::Both);
+    if (st.config.sky_background) {
+        const Sh4Coeffs<float> residual =
+            st.sky_residuals.empty() ? Sh4Coeffs<float>{} : st.sky_residuals.get(v);
+        const Image sky = sky_image(view.camera, env, st.sky_residuals.empty() ? nullptr : &residual);
+        for (int first : {kShadowedOffset, kUnshadowedOffset})
+            composite_background<float>(img, sky.pixels, first);
+    }
+    const Image shadowed = raster_channels(img, kShadowedOffset, 3);
+    const Image unshadowed = raster_channels(img, kUnshadowedOffset, 3);
+    const Image* panels[3] = {&view.rgb, &shadowed, &unshadowed};
+    const int w = view.rgb.width, h = view.rgb.height;
+    Image out(3 * w, h, 3);
+    for (int k = 0; k < 3; ++k)
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                for (int c = 0; c < 3; ++c)
+                    out.at(k * w + x, y, c) = std::clamp(panels[k]->at(x, y, c), 0.0f, 1.0f);
+    return out;
+}
+
+// Half the size, 2x2 box filter (odd edges dropped).
+Image halved(const Image& im) {
+    Image out(std::max(im.width / 2, 1), std::max(im.height / 2, 1), im.channels);
+    for (int y = 0; y < out.height; ++y)
+        for (int x = 0; x < out.width; ++x)
+            for (int c = 0; c < im.channels; ++c) {
+                const int x0 = std::min(2 * x, im.width - 1), y0 = std::min(2 * y, im.height - 1);
+                const int x1 = std::min(x0 + 1, im.width - 1), y1 = std::min(y0 + 1, im.height - 1);
+                out.at(x, y, c) =
+                    0.25f * (im.at(x0, y0, c) + im.at(x1, y0, c) + im.at(x0, y1, c) + im.at(x1, y1, c));
+            }
+    return out;
+}
+
+}  // namespace
+
 void write_previews(const std::string& dir, const Trainer& trainer, int count) {
     const auto& views = trainer.views();
     std::filesystem::create_directories(dir);
     for (int v = 0; v < std::min<int>(count, int(views.size())); ++v) {
-        const TrainView& view = views[std::size_t(v)];
-        const ShCoeffs<float> env = trainer.state().lighting.env_sh(v);
-        RasterImages<float> img =
-            render_with_environment(trainer.state().model, view.camera, env, ShadingMode::Both);
-        if (trainer.state().config.sky_background) {
-            const TrainState& st = trainer.state();
-            const Sh4Coeffs<float> residual =
-                st.sky_residuals.empty() ? Sh4Coeffs<float>{} : st.sky_residuals.get(v);
-            const Image sky = sky_image(view.camera, env, st.sky_residuals.empty() ? nullptr : &residual);
-            for (int first : {kShadowedOffset, kUnshadowedOffset})
-                composite_background<float>(img, sky.pixels, first);
-        }
-        const Image shadowed = raster_channels(img, kShadowedOffset, 3);
-        const Image unshadowed = raster_channels(img, kUnshadowedOffset, 3);
-        const Image* panels[3] = {&view.rgb, &shadowed, &unshadowed};
-        const int w = view.rgb.width, h = view.rgb.height;
-        Image out(3 * w, h, 3);
-        for (int k = 0; k < 3; ++k)
-            for (int y = 0; y < h; ++y)
-                for (int x = 0; x < w; ++x)
-                    for (int c = 0; c < 3; ++c)
-                        out.at(k * w + x, y, c) = std::clamp(panels[k]->at(x, y, c), 0.0f, 1.0f);
-        std::filesystem::path name = std::filesystem::path(dir) / view.name;
+        std::filesystem::path name = std::filesystem::path(dir) / views[std::size_t(v)].name;
         name.replace_extension(".png");
         std::filesystem::create_directories(name.parent_path());
-        write_png(name.string(), out);
+        write_png(name.string(), preview_image(trainer, v));
     }
+}
+
+void write_progress(const RunPaths& paths, const Trainer& trainer, int count) {
+    namespace fs = std::filesystem;
+    std::vector<Image> rows;
+    int width = 0, height = 0;
+    for (int v = 0; v < std::min<int>(count, int(trainer.views().size())); ++v) {
+        Image im = preview_image(trainer, v);
+        while (im.width > 960) im = halved(im);
+        width = std::max(width, im.width), height += im.height;
+        rows.push_back(std::move(im));
+    }
+    const fs::path dir = fs::path(paths.dir) / "progress";
+    fs::create_directories(dir);
+    if (!rows.empty()) {
+        Image sheet(width, height, 3);
+        int top = 0;
+        for (const Image& im : rows) {
+            for (int y = 0; y < im.height; ++y)
+                for (int x = 0; x < im.width; ++x)
+                    for (int c = 0; c < 3; ++c) sheet.at(x, top + y, c) = im.at(x, y, c);
+            top += im.height;
+        }
+        char name[32];
+        std::snprintf(name, sizeof name, "%07lld.png", static_cast<long long>(trainer.iteration()));
+        write_png((dir / name).string(), sheet);
+    }
+    std::vector<std::string> images;
+    for (const auto& e : fs::directory_iterator(dir))
+        if (e.path().extension() == ".png") images.push_back("progress/" + e.path().filename().string());
+    std::sort(images.begin(), images.end());
+    std::ifstream log(paths.log);
+    std::ostringstream text;
+    text << log.rdbuf();
+    write_file_atomically((fs::path(paths.dir) / "progress.html").string(),
+                          progress_report_html(fs::path(paths.dir).filename().string(), text.str(), images));
 }
 
 }  // namespace lumigauss

@@ -85,4 +85,8 @@ void truncate_log(const std::string& path, std::int64_t iteration);
 // the photo's learned environment (with its sky when trained with it), side by side, clipped to [0, 1].
 void write_previews(const std::string& dir, const Trainer& trainer, int count);
 
+// RUN/progress/ITERATION.png (the previews of the first `count` training views stacked, halved while wider
+// than 960 px) and RUN/progress.html (train/progress_report.h) for the trainer's current iteration.
+void write_progress(const RunPaths& paths, const Trainer& trainer, int count);
+
 }  // namespace lumigauss
