@@ -35,6 +35,8 @@ printf '  shadowed PSNR %.2f dB, SSIM %.4f | unshadowed PSNR %.2f dB | albedo PS
     "$(value shadowed_psnr)" "$(value shadowed_ssim)" "$(value unshadowed_psnr)" "$(value albedo_psnr)"
 printf '  normal error mean %.1f deg, median %.1f deg | sky pixels covered by surfels %.2f %%\n' \
     "$(value normal_mean_deg)" "$(value normal_median_deg)" "$(awk -v s="$(value sky_alpha)" 'BEGIN { print 100 * s }')"
+printf '  under a light scale fitted per channel on the training photos instead: shadowed PSNR %.2f dB\n' \
+    "$(value scaled_psnr)"
 echo
 echo "Done. Look at:"
 echo "  $out/scene/images/        the photos (one lighting each), with masks/ and sparse/0/"
@@ -42,5 +44,6 @@ echo "  $out/scene/gt/            true albedo, normals, masks; env/ holds each l
 echo "  $out/renders/             the rasterizer's renders of gt/surfels.ply (albedo colours), alpha, depth, normals"
 echo "  $out/run/                 the trained model (model.ply, lighting.lgmlp, appearance.json), config, log.jsonl"
 echo "  $out/run/previews/        photo | shadowed | unshadowed render under the learned lighting"
+echo "  $out/run/progress.html    the run's loss, PSNR and surfel plots and its previews at every checkpoint"
 echo "  $out/eval/                report.md, metrics.json and contact sheets of the test photos"
 echo "  $out/relit/               the test views relit (shadowed, unshadowed, shadow, albedo, normals, ...) per sky turn"
