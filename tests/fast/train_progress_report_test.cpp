@@ -50,7 +50,7 @@ TEST(ProgressReport, ChartsFromTheLogAndImagesNewestFirst) {
     EXPECT_EQ(count(chart_points(html, "total"), ","), 3u);
     EXPECT_EQ(count(chart_points(html, "surfels"), ","), 3u);
     EXPECT_NE(html.find("run &lt;1&gt;"), std::string::npos);
-    EXPECT_NE(html.find("iteration 30, 2 min"), std::string::npos);
+    EXPECT_NE(html.find("iteration 30, 2.0 min"), std::string::npos);
     EXPECT_LT(html.find("0000030.png"), html.find("0000010.png")) << "newest first";
 
     const std::string empty = progress_report_html("r", "", {});

@@ -22,6 +22,14 @@ std::string number(double v) {
     return buf;
 }
 
+// An axis label: whole numbers past 1000 (surfel counts, iterations) without an exponent.
+std::string label(double v) {
+    if (std::abs(v) < 1000) return number(v);
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.0f", v);
+    return buf;
+}
+
 std::string escaped(const std::string& s) {
     std::string out;
     for (char c : s) {
@@ -47,7 +55,7 @@ std::string escaped(const std::string& s) {
 
 // One line chart: the series against the iteration, its range written at the axis ends.
 std::string svg_chart(const Series& s) {
-    constexpr double kWidth = 640, kHeight = 180, kLeft = 60, kRight = 10, kTop = 10, kBottom = 24;
+    constexpr double kWidth = 660, kHeight = 180, kLeft = 80, kRight = 10, kTop = 10, kBottom = 24;
     std::string svg = "<figure><figcaption>" + std::string(s.title) + "</figcaption>";
     if (s.x.empty()) return svg + "<p>no values yet</p></figure>\n";
     const auto [ymin_it, ymax_it] = std::minmax_element(s.y.begin(), s.y.end());
@@ -69,10 +77,10 @@ std::string svg_chart(const Series& s) {
         o << "<text x=\"" << number(x) << "\" y=\"" << number(y) << "\" font-size=\"11\" text-anchor=\""
           << anchor << "\">" << t << "</text>";
     };
-    text(kLeft - 4, kTop + 10, number(ymax), "end");
-    text(kLeft - 4, kHeight - kBottom, number(ymin), "end");
-    text(kLeft, kHeight - 8, number(xmin), "start");
-    text(kWidth - kRight, kHeight - 8, number(xmax) + " iterations", "end");
+    text(kLeft - 4, kTop + 10, label(ymax), "end");
+    text(kLeft - 4, kHeight - kBottom, label(ymin), "end");
+    text(kLeft, kHeight - 8, label(xmin), "start");
+    text(kWidth - kRight, kHeight - 8, label(xmax) + " iterations", "end");
     o << "</svg>";
     return svg + o.str() + "</figure>\n";
 }
