@@ -109,8 +109,9 @@ std::string progress_report_html(const std::string& run_name, const std::string&
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>LumiGauss run " + escaped(run_name) +
         "</title>\n<style>body{font-family:sans-serif;margin:1em 2em}figure{margin:0.5em 0}"
         "figcaption{font-weight:bold}img{max-width:100%;image-rendering:pixelated}</style></head><body>\n";
-    html += "<h1>" + escaped(run_name) + "</h1>\n<p>iteration " + number(last_iteration) + ", " +
-            number(elapsed / 60) +
+    char minutes[32];
+    std::snprintf(minutes, sizeof minutes, "%.1f", elapsed / 60);
+    html += "<h1>" + escaped(run_name) + "</h1>\n<p>iteration " + label(last_iteration) + ", " + minutes +
             " min of training. Rewritten with every checkpoint; reload to follow.</p>\n";
     for (const Series& s : series) html += svg_chart(s);
     html += "<h2>Progress (photo | shadowed | unshadowed, newest first)</h2>\n";
