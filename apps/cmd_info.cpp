@@ -58,6 +58,11 @@ void print_extent(const Dataset& d) {
         std::printf("points:        none (training needs SfM points in %s)\n", d.points_path.c_str());
     else
         std::printf("points:        %zu (%s)\n", d.point_xyz.size(), d.points_path.c_str());
+    if (d.cameras_fitted_to_photos > 0)
+        std::printf(
+            "cameras:       %zu scaled down to their photos (smaller than the COLMAP camera, same "
+            "aspect ratio)\n",
+            d.cameras_fitted_to_photos);
     if (d.far_points_dropped > 0)
         std::printf("               (%zu more dropped: farther than %.4g from the cameras' centre)\n",
                     d.far_points_dropped, d.far_point_limit);

@@ -149,6 +149,11 @@ int run_train(const TrainFlags& f) {
                 "shadowed renders and shadows are not trained\n",
                 (long long)config.iterations, (long long)config.start_shadowed + 1);
     }
+    if (run.cameras_fitted_to_photos() > 0)
+        std::printf(
+            "train: %zu photos are smaller than their COLMAP camera (same aspect ratio): their "
+            "cameras were scaled to them\n",
+            run.cameras_fitted_to_photos());
     if (run.far_points_dropped() > 0)
         std::printf(
             "train: dropped %zu SfM point(s) more than %.4g from the cameras' centre (1000x their "

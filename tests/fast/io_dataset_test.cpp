@@ -176,6 +176,28 @@ TEST(DatasetColmap, HoldoutEveryEighthImageWithoutSplitFile) {
     EXPECT_EQ(load_dataset(tmp.path().string(), {.holdout_every = 0}).split(Split::Test).size(), 0u);
 }
 
+// A photo smaller than its camera with the same aspect ratio (a downscaled copy, as in an images_2/ folder)
+// gets its camera scaled to it; another aspect ratio is still an error naming both sizes.
+TEST(DatasetColmap, PhotosSmallerThanTheirCameraScaleIt) {
+    TempDir tmp;
+    test::write_scene(tmp.path(), test::small_model(3, 40, 30));
+    write_png(tmp / "images/img_1.png", test::test_image(20, 15, 3));  // half size
+    write_png(tmp / "images/img_2.png", test::test_image(13, 10, 3));  // 40x30 / 3, rounded
+    const Dataset d = load_dataset(tmp.path().string());
+    EXPECT_EQ(d.cameras_fitted_to_photos, 2u);
+    const Camera& half = d.views[1].camera;
+    EXPECT_EQ(half.width, 20);
+    EXPECT_EQ(half.height, 15);
+    EXPECT_DOUBLE_EQ(half.fx, 21.0 / 2);  // small_model: fx = 20 + i
+    EXPECT_DOUBLE_EQ(half.cx, 10.0);
+    EXPECT_EQ(d.load_image(d.views[1]).width, 20);
+    const Dataset quarter = load_dataset(tmp.path().string(), {.downscale = 2});
+    EXPECT_EQ(quarter.views[1].camera.width, 10) << "-r applies after the fit";
+    EXPECT_EQ(quarter.load_image(quarter.views[1]).width, 10);
+    write_png(tmp / "images/img_1.png", test::test_image(20, 10, 3));  // another aspect ratio
+    expect_error([&] { load_dataset(tmp.path().string()); }, {"img_1.png", "20x10", "40x30"});
+}
+
 // train --test-every N / --no-test: the override wins over a split file.
 TEST(DatasetColmap, TestEveryOverridesTheSplitFile) {
     TempDir tmp;

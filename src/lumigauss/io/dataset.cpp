@@ -1,6 +1,7 @@
 #include "lumigauss/io/dataset.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <set>
 
@@ -19,9 +20,24 @@ std::string size_text(int w, int h) {
 }
 
 // Header-only checks: the image is readable and as large as its camera says; the mask as large as the image.
-void check_files(const RawView& raw) {
-    const View& v = raw.view;
+// A photo smaller than its camera by one factor on both sides (to a pixel of rounding): a downscaled copy
+// of the photos (an images_2/ folder put in place of images/), which nerfstudio and gsplat accept.
+bool same_aspect_smaller(int width, int height, const Camera& camera) {
+    if (width >= camera.width || height >= camera.height) return false;
+    const double expected_height = double(width) * camera.height / camera.width;
+    const double expected_width = double(height) * camera.width / camera.height;
+    return std::abs(expected_height - height) <= 1.0 && std::abs(expected_width - width) <= 1.0;
+}
+
+// Checks the files of a view; returns true when its camera was scaled to a smaller photo.
+bool check_files(RawView& raw) {
+    View& v = raw.view;
     const ImageInfo image = read_image_info(v.image_path);
+    bool fitted = false;
+    if (same_aspect_smaller(image.width, image.height, v.camera)) {
+        v.camera = v.camera.resized(image.width, image.height);
+        fitted = true;
+    }
     if (image.width != v.camera.width || image.height != v.camera.height)
         fail_in_file(v.image_path, "image is " + size_text(image.width, image.height) + " but its camera (" +
                                        raw.camera_origin + ") is " +
@@ -35,6 +51,7 @@ void check_files(const RawView& raw) {
                                    " but its image " + v.image_path + " is " +
                                    size_text(image.width, image.height));
     }
+    return fitted;
 }
 
 void check_unique_names(const std::vector<RawView>& views) {
@@ -45,8 +62,8 @@ void check_unique_names(const std::vector<RawView>& views) {
 }
 
 // Full-resolution file size must match the camera before anything is downscaled.
-View finish_view(const RawView& raw, int factor) {
-    check_files(raw);
+View finish_view(RawView raw, int factor, std::size_t& fitted) {
+    if (check_files(raw)) ++fitted;
     View v = raw.view;
     v.source_width = v.camera.width;
     v.source_height = v.camera.height;
@@ -161,7 +178,7 @@ Dataset load_dataset(const std::string& root, const DatasetOptions& options) {
     d.point_rgb = std::move(raw.point_rgb);
     d.points_path = std::move(raw.points_path);
     d.views.reserve(raw.views.size());
-    for (const RawView& r : raw.views) d.views.push_back(finish_view(r, f));
+    for (const RawView& r : raw.views) d.views.push_back(finish_view(r, f, d.cameras_fitted_to_photos));
     drop_far_points(d);
     return d;
 }

@@ -65,6 +65,9 @@ struct Dataset {
     // extent about their centroid, io/scene_extent.h): one point at 1e20 made the initial surfel scale
     // overflow.
     std::size_t far_points_dropped = 0;
+    // Views whose photo was smaller than its camera with the same aspect ratio (a downscaled copy of the
+    // photos): their camera was scaled to the photo (Camera::resized) before any -r downscale.
+    std::size_t cameras_fitted_to_photos = 0;
     double far_point_limit = 0;  // the distance from the cameras' centroid beyond which they were dropped
 
     // RGB in [0, 1] (gray is replicated, alpha dropped), resized by the downscale factor. Throws Error naming
