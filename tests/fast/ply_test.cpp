@@ -64,6 +64,19 @@ TEST(Ply, ReadsBigEndianAndSkipsBinaryListElements) {
     EXPECT_EQ(r.column("s", "")[0], -7.f);
 }
 
+// An element without properties holds no bytes however many records it declares; counting through them
+// hung the reader (libFuzzer, fuzz/regressions/ply_vertices/element_without_properties).
+TEST(Ply, ElementsWithoutPropertiesAreSkippedAtOnce) {
+    TempDir dir;
+    std::ofstream out(dir / "e.ply", std::ios::binary);
+    out << "ply\nformat binary_little_endian 1.0\nelement empty 1000000000000000\nelement vertex 1\n"
+           "property float x\nend_header\n";
+    const float x = 2.5f;
+    out.write(reinterpret_cast<const char*>(&x), 4);
+    out.close();
+    EXPECT_EQ(read_ply_vertices(dir / "e.ply").column("x", "")[0], 2.5f);
+}
+
 TEST(Ply, ErrorsNameTheFileAndTheProblem) {
     TempDir dir;
     expect_error([&] { read_ply_vertices(dir / "missing.ply"); }, {"missing.ply", "cannot open"});
