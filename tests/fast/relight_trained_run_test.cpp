@@ -8,6 +8,7 @@
 #include <functional>
 
 #include "lumigauss/model/relightable_ply.h"
+#include "lumigauss/model/scene_record.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/util/error.h"
 #include "relight_test_util.h"
@@ -70,6 +71,37 @@ TEST(RelightTrainedRun, LoadsModelLightingNamesAndResolution) {
             for (int c = 0; c < 3; ++c) EXPECT_EQ(sh.c[k][c], double(expected.c[k][c]));
     }
     EXPECT_THROW(run.learned_sh(2), Error);
+}
+
+TEST(RelightTrainedRun, SkyHorizonIsTheTrainingCamerasMeanUpWithTheConfigAngles) {
+    TempDir tmp("relight_trained_run_horizon");
+    const std::string dir = write_run(tmp, 2, {"x.png", "y.png"});
+    {
+        std::ofstream c(run_paths(dir).config);
+        c << "{\"sky_background\": true, \"sky_horizon_start\": 3, \"sky_horizon_fade\": 5}\n";
+    }
+    // Without scene.json the run's up is unknown: no horizon, as runs trained before it.
+    EXPECT_EQ(load_trained_run(dir).sky_horizon.fade_degrees, 0.0f);
+    // Two level cameras of a y-down world (COLMAP style: camera y = world y), one turned 90 deg about the
+    // vertical; a held-out photo looking straight down must not count.
+    SceneRecord record;
+    record.scene = "/nowhere", record.format = "colmap-text";
+    record.photos.push_back({"x.png", "train", {1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 0}});
+    record.photos.push_back({"y.png", "train", {0, 0, -1, 0, 1, 0, 1, 0, 0}, {0, 0, 0}});
+    record.photos.push_back({"t.png", "test", {1, 0, 0, 0, 0, 1, 0, -1, 0}, {0, 0, 0}});
+    save_scene_record(run_paths(dir).scene, record);
+    const SkyHorizon h = load_trained_run(dir).sky_horizon;
+    EXPECT_EQ(h.start_degrees, 3.0f);
+    EXPECT_EQ(h.fade_degrees, 5.0f);
+    EXPECT_NEAR(h.up.x, 0, 1e-6);
+    EXPECT_NEAR(h.up.y, -1, 1e-6);
+    EXPECT_NEAR(h.up.z, 0, 1e-6);
+    // A run trained without a fade has no horizon.
+    {
+        std::ofstream c(run_paths(dir).config);
+        c << "{\"sky_background\": true, \"sky_horizon_start\": 3, \"sky_horizon_fade\": 0}\n";
+    }
+    EXPECT_EQ(load_trained_run(dir).sky_horizon.fade_degrees, 0.0f);
 }
 
 TEST(RelightTrainedRun, NamesTheMissingOrInconsistentFile) {

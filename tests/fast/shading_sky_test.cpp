@@ -70,6 +70,52 @@ TEST(SkyColour, ResidualAddsToTheEnvironment) {
     EXPECT_NEAR(sky_radiance<double>(env, nullptr, up).x, eval_sh(env, up).x, 1e-15);
 }
 
+TEST(SkyColour, VisibilityFadesBelowTheHorizon) {
+    const double start = std::sin(4 * std::numbers::pi / 180), end = std::sin(8 * std::numbers::pi / 180);
+    const auto at = [&](double degrees_below, Vec3d up = {0, 0, 1}) {
+        const double a = -degrees_below * std::numbers::pi / 180;
+        return sky_visibility(up, start, end, Vec3d{std::cos(a), 0, std::sin(a)});
+    };
+    EXPECT_EQ(at(-30), 1.0);  // above the horizon
+    EXPECT_EQ(at(0), 1.0);
+    EXPECT_EQ(at(4), 1.0);  // the fade starts
+    EXPECT_NEAR(at(6), (end - std::sin(6 * std::numbers::pi / 180)) / (end - start), 1e-12);
+    EXPECT_GT(at(6), 0.45);
+    EXPECT_LT(at(6), 0.55);
+    EXPECT_EQ(at(8.01), 0.0);  // gone
+    EXPECT_EQ(at(90), 0.0);
+    // Measured from the given up, not from +z: about -y (COLMAP's y down), a ray along +z is level.
+    EXPECT_EQ(sky_visibility(Vec3d{0, -1, 0}, start, end, Vec3d{0, 0, 1}), 1.0);
+    EXPECT_EQ(sky_visibility(Vec3d{0, -1, 0}, start, end, Vec3d{0, 1, 0}), 0.0);
+}
+
+TEST(SkyImage, NothingIsDrawnWhereTheHorizonHidesTheSky) {
+    Camera cam;  // looking along world +x, level: the top half of the image is above the horizon
+    cam.width = 8, cam.height = 64, cam.fx = cam.fy = 20, cam.cx = 4, cam.cy = 32;
+    cam.rotation = Mat3d{{{0, -1, 0}, {0, 0, -1}, {1, 0, 0}}};
+    ShCoeffs<float> env;
+    env.c[0] = {1.5f, 1.5f, 1.5f};  // bright in every direction, below the horizon too
+    const Image open = sky_image(cam, env);
+    const Image cut = sky_image(cam, env, nullptr, {{0, 0, 1}, 4, 4});
+    for (int y = 0; y < cam.height; ++y) {
+        const double below = -std::asin(pixel_ray_direction(cam, 4, y).z) * 180 / std::numbers::pi;
+        SCOPED_TRACE(below);
+        EXPECT_GT(open.at(4, y, 0), 0.5f);
+        if (below <= 3.9) {
+            EXPECT_FLOAT_EQ(cut.at(4, y, 0), open.at(4, y, 0));
+        }
+        if (below >= 8.1) {
+            EXPECT_EQ(cut.at(4, y, 0), 0.0f);
+        }
+        if (below > 4.1 && below < 7.9) {
+            EXPECT_GT(cut.at(4, y, 0), 0.0f);
+            EXPECT_LT(cut.at(4, y, 0), open.at(4, y, 0));
+        }
+    }
+    // No fade, no horizon: the default draws every direction.
+    EXPECT_EQ(sky_image(cam, env, nullptr, {{0, 0, 1}, 4, 0}).pixels, open.pixels);
+}
+
 TEST(SkyImage, PixelRaysFollowTheCamera) {
     Camera cam;
     cam.width = 64, cam.height = 48, cam.fx = cam.fy = 50, cam.cx = 32, cam.cy = 24;
@@ -87,7 +133,7 @@ TEST(SkyImage, PixelRaysFollowTheCamera) {
     EXPECT_NEAR(length(rays[100].cast<double>()), 1.0, 1e-6);
 }
 
-TEST(SkyImage, BackwardMatchesFiniteDifferences) {
+void check_sky_backward(const SkyHorizon& horizon) {
     const Camera cam = testing::test_camera(9, 7);
     const std::vector<Vec3f> rays = pixel_ray_directions(cam);
     std::mt19937 rng(5);
@@ -102,14 +148,14 @@ TEST(SkyImage, BackwardMatchesFiniteDifferences) {
     for (float& w : wr) w = float(u(rng));
     const auto loss = [&] {
         SkyPixels sky;
-        sky_pixels(rays, env, &residual, sky);
+        sky_pixels(rays, env, &residual, sky, horizon);
         double l = 0;
         for (std::size_t i = 0; i < wc.size(); ++i)
             l += double(wc[i]) * sky.colour[i] + double(wr[i]) * sky.radiance[i];
         return l;
     };
     SkyPixels sky;
-    sky_pixels(rays, env, &residual, sky);
+    sky_pixels(rays, env, &residual, sky, horizon);
     const SkyGrads g = sky_pixels_backward(rays, sky, wc, wr);
     const auto check = [&](float& x, float analytic, const char* what, int k) {
         const float x0 = x;
@@ -126,6 +172,23 @@ TEST(SkyImage, BackwardMatchesFiniteDifferences) {
         for (int c = 0; c < 3; ++c) check(env.c[k][c], g.env.c[k][c], "env", k);
     for (int k = 0; k < kSh4Count; ++k)
         for (int c = 0; c < 3; ++c) check(residual.c[k][c], g.residual.c[k][c], "residual", k);
+}
+
+TEST(SkyImage, BackwardMatchesFiniteDifferences) {
+    check_sky_backward({});
+}
+
+TEST(SkyImage, BackwardMatchesFiniteDifferencesWithAHorizon) {
+    // The test camera looks roughly along +z with y down: an up near -y puts the horizon across its view.
+    const Camera cam = testing::test_camera(9, 7);
+    const std::vector<Vec3f> rays = pixel_ray_directions(cam);
+    const Vec3f up = normalize(Vec3f{0.0f, -1.0f, 0.25f});
+    int faded = 0;
+    SkyPixels sky;
+    sky_pixels(rays, ShCoeffs<float>{}, nullptr, sky, {up, 2, 10});
+    for (float v : sky.visibility) faded += v > 0 && v < 1;
+    ASSERT_GT(faded, 5);  // the fade crosses the image, so its slope is checked
+    check_sky_backward({up, 2, 10});
 }
 
 }  // namespace

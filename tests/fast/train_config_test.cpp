@@ -117,6 +117,8 @@ std::vector<MemberChange> every_member() {
         {"faithful_radii_reset", [](TrainConfig& c) { c.faithful_radii_reset = false; }},
         {"init_normals_from_points", [](TrainConfig& c) { c.init_normals_from_points = true; }},
         {"sky_background", [](TrainConfig& c) { c.sky_background = true; }},
+        {"sky_horizon_start", [](TrainConfig& c) { c.sky_horizon_start = 2; }},
+        {"sky_horizon_fade", [](TrainConfig& c) { c.sky_horizon_fade = 5; }},
         {"sky_residual", [](TrainConfig& c) { c.sky_residual = true; }},
         {"lambda_sky_residual", [](TrainConfig& c) { c.lambda_sky_residual = 0.125; }},
         {"lr_sky_residual", [](TrainConfig& c) { c.lr_sky_residual = 0.03; }},
@@ -230,7 +232,8 @@ TEST(TrainConfigPreset, PaperFastShrinksTheScheduleOnly) {
 TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
     const std::set<std::string> improvements = {
         "init_normals_from_points", "sky_background",  "lambda_sky_alpha",      "sky_free_regularizers",
-        "lambda_background_alpha",  "prune_until_end", "densify_near_fraction", "downscale"};
+        "lambda_background_alpha",  "prune_until_end", "densify_near_fraction", "downscale",
+        "sky_horizon_start",        "sky_horizon_fade"};
     for (const auto& [improved, base] : {std::pair{"default", "paper"}, std::pair{"fast", "paper-fast"}}) {
         SCOPED_TRACE(improved);
         const Json a = Json::parse(train_config_to_json(train_preset(improved)));
@@ -248,6 +251,7 @@ TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
     EXPECT_FALSE(paper.init_normals_from_points || paper.sky_background || paper.prune_until_end);
     EXPECT_EQ(paper.lambda_sky_alpha, 0.0);
     EXPECT_EQ(paper.lambda_background_alpha, 0.0);
+    EXPECT_EQ(paper.sky_horizon_fade, 0.0);
 }
 
 TEST(TrainConfigPreset, EveryPresetValidates) {
@@ -271,7 +275,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 60, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 62, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;
@@ -633,6 +637,9 @@ TEST(TrainConfigValidate, RejectsEachBadValueNamingTheKey) {
         {"log_interval", [](TrainConfig& c) { c.log_interval = 0; }},
         {"lambda_shadow", [](TrainConfig& c) { c.lambda_shadow = std::numeric_limits<double>::quiet_NaN(); }},
         {"lr_mlp", [](TrainConfig& c) { c.lr_mlp = std::numeric_limits<double>::infinity(); }},
+        {"sky_horizon_start", [](TrainConfig& c) { c.sky_horizon_start = -1; }},
+        {"sky_horizon_fade", [](TrainConfig& c) { c.sky_horizon_fade = -1; }},
+        {"sky_horizon_fade", [](TrainConfig& c) { c.sky_horizon_start = 60, c.sky_horizon_fade = 40; }},
     };
     for (const char* preset : {"paper", "fast"}) {
         for (const Case& c : cases) {

@@ -126,6 +126,20 @@ TEST(ViewSceneInfo, ListsGivenLightsThenPhotosThenUniform) {
     EXPECT_EQ(j["camera"]["fx"].get<double>(), cam.fx);
     EXPECT_EQ(j["camera"]["R"][1][2].get<double>(), cam.rotation(1, 2));
     EXPECT_GT(j["radius"].get<double>(), 0.0);
+    EXPECT_TRUE(j["sky_horizon"].is_null());  // trained without one
+}
+
+TEST(ViewSceneInfo, PassesTheRunsSkyHorizonToTheViewer) {
+    const Camera cam = testing::test_camera();
+    TrainedRun run = relight_test::in_memory_run(relight_test::random_model(cam, 4, 30), {"p0.jpg"});
+    run.sky_background = true;
+    run.sky_horizon = {{0, -1, 0}, 4, 4};
+    const nlohmann::json j =
+        nlohmann::json::parse(scene_json(describe_scene(run, {}, parse_up_axis("-y"), cam)));
+    EXPECT_EQ(j["sky_background"], true);
+    EXPECT_EQ(j["sky_horizon"]["up"][1].get<double>(), -1.0);
+    EXPECT_EQ(j["sky_horizon"]["start_degrees"].get<double>(), 4.0);
+    EXPECT_EQ(j["sky_horizon"]["fade_degrees"].get<double>(), 4.0);
 }
 
 TEST(ViewSceneInfo, UniformEnvironmentHasIrradianceOne) {

@@ -126,8 +126,9 @@ export class SplatRenderer {
   }
 
   // view: {R (rows), t, fx, fy, cx, cy, width, height}; env: Float32Array(27); mode: a MODES name;
-  // ball: null or {mode: 0|1, size (pixels)}; sky: draw the light's sky behind the colour views.
-  render(view, env, mode, ball, sky = false) {
+  // ball: null or {mode: 0|1, size (pixels)}; sky: draw the light's sky behind the colour views;
+  // horizon: null or the scene's sky_horizon {up, start_degrees, fade_degrees} (where that sky ends).
+  render(view, env, mode, ball, sky = false, horizon = null) {
     const gl = this.gl;
     const { width, height } = view;
     if (this.canvas.width !== width || this.canvas.height !== height) {
@@ -176,6 +177,11 @@ export class SplatRenderer {
     gl.uniform1i(c.u.u_mode, m);
     gl.uniform1i(c.u.u_unitRange, this.floatTarget ? 0 : 1);
     gl.uniform1i(c.u.u_sky, sky ? 1 : 0);
+    const sine = (deg) => Math.sin(Math.min(Math.max(deg, 0), 90) * Math.PI / 180);
+    const up = horizon ? horizon.up : [0, 0, 1];
+    gl.uniform3f(c.u.u_horizonUp, up[0], up[1], up[2]);
+    gl.uniform2f(c.u.u_horizonSines, horizon ? sine(horizon.start_degrees) : 0,
+                 horizon ? sine(horizon.start_degrees + horizon.fade_degrees) : 0);
     this.setCamera(c.u, view);
     gl.uniform4f(c.u.u_intr, view.fx, view.fy, view.cx, view.cy);
     gl.uniform2f(c.u.u_size, width, height);

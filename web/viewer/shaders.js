@@ -187,13 +187,16 @@ void main() {
 
 // The per-pixel step after blending: what the C++ does to the rasterised maps before writing PNGs.
 // With u_sky, the colour views are composited over the light's sky (shading/sky_colour.h: the radiance
-// along the pixel's ray, floored at 1e-4, to the power 1/2.2, clipped at 1), as `render --background sky`.
+// along the pixel's ray, floored at 1e-4, to the power 1/2.2, clipped at 1), as `render --background sky`,
+// fading out below the horizon as the run was trained (sky_visibility in shading/sky_colour.h).
 export const COMPOSITE_FS = `#version 300 es
 precision highp float;
 uniform highp sampler2D u_accum;
 uniform int u_mode;
 uniform bool u_unitRange;
 uniform bool u_sky;
+uniform vec3 u_horizonUp;       // the training cameras' mean up
+uniform vec2 u_horizonSines;    // sines of the depressions where the sky starts to fade and is gone; y <= 0: none
 uniform vec3 u_r0, u_r1, u_r2;  // world-to-camera rotation, rows
 uniform vec4 u_intr;            // fx, fy, cx, cy
 uniform vec2 u_size;
@@ -203,7 +206,12 @@ vec3 sky() {
   vec2 px = vec2(gl_FragCoord.x, u_size.y - gl_FragCoord.y);  // pixel centre, image rows from the top
   vec3 dc = vec3((px.x - u_intr.z) / u_intr.x, (px.y - u_intr.w) / u_intr.y, 1.0);
   vec3 d = normalize(dc.x * u_r0 + dc.y * u_r1 + dc.z * u_r2);  // R^T dc: world frame
-  return min(pow(max(radiance(d), vec3(1e-4)), vec3(1.0 / 2.2)), vec3(1.0));
+  float visible = 1.0;
+  if (u_horizonSines.y > 0.0) {
+    float depression = -dot(u_horizonUp, d);
+    visible = clamp((u_horizonSines.y - depression) / max(u_horizonSines.y - u_horizonSines.x, 1e-6), 0.0, 1.0);
+  }
+  return visible * min(pow(max(radiance(d), vec3(1e-4)), vec3(1.0 / 2.2)), vec3(1.0));
 }
 void main() {
   vec4 c = texelFetch(u_accum, ivec2(gl_FragCoord.xy), 0);

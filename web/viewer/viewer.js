@@ -120,7 +120,7 @@ class Viewer {
 
   draw(view, withBall = true) {
     this.renderer.render(view, this.env, this.mode, withBall && this.ball.mode !== 'off' ? this.ball : null,
-                         this.sky);
+                         this.sky, this.scene.sky_horizon || null);
   }
 
   // --- interactive use ---

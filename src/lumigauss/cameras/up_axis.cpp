@@ -23,6 +23,14 @@ Vec3d parse_up_axis(const std::string& text) {
     throw Error("up axis '" + text + "': expected one of +x, -x, +y, -y, +z, -z (or auto)");
 }
 
+Vec3d mean_camera_up(const std::vector<Mat3d>& world_to_camera) {
+    Vec3d mean{};
+    for (const Mat3d& r : world_to_camera) mean += -r.row(1);
+    const double n = length(mean);
+    if (!(n > 1e-9 * double(world_to_camera.size()))) return {};
+    return (1.0 / n) * mean;
+}
+
 Vec3d estimate_up_axis(const std::vector<Camera>& cameras) {
     if (cameras.empty()) throw Error("up axis auto: no camera to estimate it from");
     Vec3d mean{};

@@ -15,6 +15,11 @@ namespace lumigauss {
 // "x", "+x", "-x", ... "-z" (case-insensitive) -> the unit vector. Throws Error on anything else.
 Vec3d parse_up_axis(const std::string& text);
 
+// The unit mean of the world up vectors -(row 1 of R) of world-to-camera rotations (the cameras' -y), or
+// zero when there is none or they cancel out. Photos are taken roughly level, so this is the world's up
+// direction where the horizon lies (not rounded to an axis).
+Vec3d mean_camera_up(const std::vector<Mat3d>& world_to_camera);
+
 // The signed coordinate axis closest to the mean world up vector (-(row 1 of R), the camera's -y) of the
 // cameras. Throws Error when there is no camera or the mean vanishes.
 Vec3d estimate_up_axis(const std::vector<Camera>& cameras);

@@ -95,7 +95,8 @@ Image shadowed_panel(const RelightableRun& run, RelitRenderer& renderer, const C
     const RasterImages<float>& relit = renderer.render(camera, env);
     Image shadowed = raster_channels(relit, kRelitShadowed, 3);
     if (run.sky_background)
-        shadowed = over_background_image(shadowed, alpha_image(relit), sky_image(camera, env));
+        shadowed = over_background_image(shadowed, alpha_image(relit),
+                                         sky_image(camera, env, nullptr, run.sky_horizon));
     return clamp01(shadowed);
 }
 
@@ -187,6 +188,7 @@ RelightableRun load_relightable_run(const std::string& path) {
     for (int i = 0; i < trained.lighting.num_images(); ++i) run.learned_sh.push_back(trained.learned_sh(i));
     run.downscale = trained.downscale;
     run.sky_background = trained.sky_background;
+    run.sky_horizon = trained.sky_horizon;
     return run;
 }
 
@@ -361,7 +363,7 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
         p.shadowed = raster_channels(relit, kRelitShadowed, 3);
         p.unshadowed = raster_channels(relit, kRelitUnshadowed, 3);
         if (run.sky_background) {
-            const Image sky = sky_image(v->camera, env);
+            const Image sky = sky_image(v->camera, env, nullptr, run.sky_horizon);
             const Image alpha = alpha_image(relit);
             p.shadowed = over_background_image(p.shadowed, alpha, sky);
             p.unshadowed = over_background_image(p.unshadowed, alpha, sky);

@@ -58,6 +58,7 @@
 #include "lumigauss/model/surfel_model.h"
 #include "lumigauss/render/rasterizer.h"
 #include "lumigauss/shading/sh.h"
+#include "lumigauss/shading/sky_image.h"
 
 namespace lumigauss {
 
@@ -93,6 +94,7 @@ struct RelightableRun {
     std::vector<ShCoeffs<double>> learned_sh;  // the lighting MLP's env_sh(i) of each of them
     int downscale = 0;                         // config.json "downscale"; 0 if unknown
     bool sky_background = false;               // trained with the photo's sky behind the surfels
+    SkyHorizon sky_horizon;                    // where that sky ends below the horizon (TrainedRun's)
 };
 
 // A run folder (model.ply, lighting.lgmlp, appearance.json and config.json if present) or a bare relightable

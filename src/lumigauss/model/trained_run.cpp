@@ -5,11 +5,46 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/io/text_file.h"
 #include "lumigauss/model/relightable_ply.h"
+#include "lumigauss/model/scene_record.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {
+
+namespace {
+
+// The horizon the run was trained with (Trainer::sky_horizon): the config's angles about the mean up of
+// the training photos in scene.json. None when either is missing.
+SkyHorizon recorded_sky_horizon(const nlohmann::json& config, const std::string& dir) {
+    SkyHorizon horizon;
+    const auto number = [&](const char* key) {
+        return config.is_object() && config.contains(key) && config[key].is_number()
+                   ? config[key].get<double>()
+                   : 0.0;
+    };
+    const double start = number("sky_horizon_start"), fade = number("sky_horizon_fade");
+    if (!(fade > 0)) return horizon;
+    const std::optional<SceneRecord> scene = load_scene_record(run_paths(dir).scene);
+    if (!scene) return horizon;
+    std::vector<Mat3d> rotations;
+    for (const RecordedPhoto& p : scene->photos) {
+        if (p.split != "train") continue;
+        Mat3d r;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) r(i, j) = p.rotation[std::size_t(3 * i + j)];
+        rotations.push_back(r);
+    }
+    const Vec3d up = mean_camera_up(rotations);
+    if (!(length(up) > 0)) return horizon;
+    horizon.up = up.cast<float>();
+    horizon.start_degrees = float(start);
+    horizon.fade_degrees = float(fade);
+    return horizon;
+}
+
+}  // namespace
 
 int TrainedRun::find_image(const std::string& name) const {
     for (std::size_t i = 0; i < image_names.size(); ++i)
@@ -57,6 +92,7 @@ TrainedRun load_trained_run(const std::string& dir) {
             run.downscale = c["downscale"].get<int>();
         if (c.is_object() && c.contains("sky_background") && c["sky_background"].is_boolean())
             run.sky_background = c["sky_background"].get<bool>();
+        run.sky_horizon = recorded_sky_horizon(c, dir);
     }
     return run;
 }

@@ -10,6 +10,7 @@
 #include "lumigauss/model/sky_residual.h"
 #include "lumigauss/model/surfel_model.h"
 #include "lumigauss/shading/sh.h"
+#include "lumigauss/shading/sky_image.h"
 
 namespace lumigauss {
 
@@ -22,6 +23,9 @@ struct TrainedRun {
     int downscale = 0;                     // config.json "downscale"; 0 if unknown
     bool sky_background = false;           // config.json "sky_background": trained with the sky drawn behind
     SkyResiduals sky_residuals;            // sky.lgsky when present (per-photo sky residuals)
+    // Where that sky ends below the horizon: config.json sky_horizon_start/fade, about the mean up of the
+    // training cameras that scene.json records (no horizon without them, as the run was trained then).
+    SkyHorizon sky_horizon;
 
     // Embedding index of the training photo called exactly `name`, or -1.
     int find_image(const std::string& name) const;
@@ -29,9 +33,9 @@ struct TrainedRun {
     ShCoeffs<double> learned_sh(int index) const;
 };
 
-// Loads model.ply, lighting.lgmlp, appearance.json (and config.json if present) of a run folder. Throws Error
-// naming the folder or the first missing or malformed file, or the mismatch between the number of
-// embeddings and of photos.
+// Loads model.ply, lighting.lgmlp, appearance.json (and config.json and scene.json if present) of a run
+// folder. Throws Error naming the folder or the first missing or malformed file, or the mismatch between the
+// number of embeddings and of photos.
 TrainedRun load_trained_run(const std::string& dir);
 
 // True when `path` names a regular file ending in .ply (case-insensitive).

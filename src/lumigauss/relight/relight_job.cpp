@@ -133,9 +133,10 @@ Image frame_sky(const Camera& camera, const RelightSummary& summary, const Train
         light.photo_index >= 0 && light.photo_index < run.sky_residuals.num_images()) {
         Sh4Coeffs<float> residual = run.sky_residuals.get(light.photo_index);
         for (Vec3f& c : residual.c) c = float(summary.light_factor) * c;
-        return sky_image(camera, env, &residual);
+        return sky_image(camera, env, &residual, run.sky_horizon);
     }
-    return sky_image(camera, env);
+    // The horizon is about the frame the model was trained in, so a turned light keeps it.
+    return sky_image(camera, env, nullptr, run.sky_horizon);
 }
 
 }  // namespace

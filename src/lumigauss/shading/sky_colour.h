@@ -57,6 +57,21 @@ LG_HD inline Vec3<T> sky_radiance(const ShCoeffs<T>& env, const Sh4Coeffs<T>* re
     return r;
 }
 
+// How much of the sky a ray sees, from the sines of the ray's depression below the horizon (up . dir < 0)
+// where the sky starts to fade (start_sine) and where it is gone (end_sine > start_sine): 1 above the
+// start, linear to 0 at the end. In an outdoor photo the ground hides the lower half of the environment,
+// so a pixel well below the horizon that the surfels leave uncovered is a hole in the ground, not sky:
+// drawn with the environment's lower half, holes were painted by light that no photo constrains, and the
+// learned lights grew a bright floor to paint them. Just below the horizon lies the far field (ground
+// beyond the reconstruction, distant buildings), which the environment may keep drawing.
+template <typename T>
+LG_HD inline T sky_visibility(Vec3<T> up, T start_sine, T end_sine, Vec3<T> dir) {
+    const T depression = -dot(up, dir);
+    if (!(depression > start_sine)) return T(1);
+    if (!(depression < end_sine)) return T(0);
+    return (end_sine - depression) / (end_sine - start_sine);
+}
+
 // Display-space colour of a sky radiance.
 template <typename T>
 LG_HD inline Vec3<T> sky_colour_of(Vec3<T> radiance) {

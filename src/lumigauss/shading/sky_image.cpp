@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "lumigauss/shading/sky_colour.h"
 #include "lumigauss/util/error.h"
@@ -34,14 +35,25 @@ std::vector<Vec3f> pixel_ray_directions(const Camera& camera) {
 }
 
 void sky_pixels(std::span<const Vec3f> rays, const ShCoeffs<float>& env, const Sh4Coeffs<float>* residual,
-                SkyPixels& out) {
+                SkyPixels& out, const SkyHorizon& horizon) {
     out.radiance.resize(3 * rays.size());
     out.colour.resize(3 * rays.size());
+    const bool has_horizon = horizon.fade_degrees > 0;
+    out.visibility.resize(has_horizon ? rays.size() : 0);
+    const auto sine = [](double degrees) { return float(std::sin(degrees * std::numbers::pi / 180.0)); };
+    const float start_sine = sine(std::clamp(double(horizon.start_degrees), 0.0, 90.0));
+    const float end_sine = sine(std::clamp(double(horizon.start_degrees + horizon.fade_degrees), 0.0, 90.0));
+    const float up_length = length(horizon.up);
+    if (has_horizon && !(up_length > 0)) throw Error("sky_pixels: the horizon's up direction is zero");
+    const Vec3f up = (1.0f / up_length) * horizon.up;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), kChunk),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                           for (std::size_t p = r.begin(); p < r.end(); ++p) {
                               const Vec3f radiance = sky_radiance(env, residual, rays[p]);
-                              const Vec3f colour = sky_colour_of(radiance);
+                              const float visible =
+                                  has_horizon ? sky_visibility(up, start_sine, end_sine, rays[p]) : 1.0f;
+                              if (has_horizon) out.visibility[p] = visible;
+                              const Vec3f colour = visible * sky_colour_of(radiance);
                               for (int c = 0; c < 3; ++c) {
                                   out.radiance[3 * p + std::size_t(c)] = radiance[c];
                                   out.colour[3 * p + std::size_t(c)] = colour[c];
@@ -50,10 +62,11 @@ void sky_pixels(std::span<const Vec3f> rays, const ShCoeffs<float>& env, const S
                       });
 }
 
-Image sky_image(const Camera& camera, const ShCoeffs<float>& env, const Sh4Coeffs<float>* residual) {
+Image sky_image(const Camera& camera, const ShCoeffs<float>& env, const Sh4Coeffs<float>* residual,
+                const SkyHorizon& horizon) {
     Image out(camera.width, camera.height, 3);
     SkyPixels sky;
-    sky_pixels(pixel_ray_directions(camera), env, residual, sky);
+    sky_pixels(pixel_ray_directions(camera), env, residual, sky, horizon);
     out.pixels = std::move(sky.colour);
     return out;
 }
@@ -65,26 +78,32 @@ SkyGrads sky_pixels_backward(std::span<const Vec3f> rays, const SkyPixels& sky,
     if (sky.radiance.size() != 3 * n || (!g_colour.empty() && g_colour.size() != 3 * n) ||
         (!g_radiance.empty() && g_radiance.size() != 3 * n))
         throw Error("sky_pixels_backward: the sky or a gradient does not fit the rays");
+    if (!sky.visibility.empty() && sky.visibility.size() != n)
+        throw Error("sky_pixels_backward: the sky's visibility does not fit the rays");
+    const auto visibility = [&](std::size_t p) {
+        return sky.visibility.empty() ? 1.0 : double(sky.visibility[p]);
+    };
     const std::size_t chunks = (n + kChunk - 1) / kChunk;
     std::vector<ShCoeffs<double>> env_parts(chunks);
     std::vector<Sh4Coeffs<double>> residual_parts(chunks);
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, chunks), [&](const tbb::blocked_range<std::size_t>& r) {
-            for (std::size_t c = r.begin(); c < r.end(); ++c)
-                for (std::size_t p = c * kChunk; p < std::min(n, (c + 1) * kChunk); ++p) {
-                    Vec3d g{};
-                    for (int k = 0; k < 3; ++k) {
-                        const std::size_t i = 3 * p + std::size_t(k);
-                        double gk = g_radiance.empty() ? 0.0 : double(g_radiance[i]);
-                        if (!g_colour.empty() && g_colour[i] != 0)
-                            gk += double(g_colour[i]) * sky_channel_derivative(double(sky.radiance[i]));
-                        g[k] = gk;
-                    }
-                    if (g.x == 0 && g.y == 0 && g.z == 0) continue;
-                    sky_radiance_vjp(rays[p].cast<double>(), g, env_parts[c],
-                                     with_residual ? &residual_parts[c] : nullptr);
-                }
-        });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t c = r.begin(); c < r.end(); ++c)
+                              for (std::size_t p = c * kChunk; p < std::min(n, (c + 1) * kChunk); ++p) {
+                                  Vec3d g{};
+                                  for (int k = 0; k < 3; ++k) {
+                                      const std::size_t i = 3 * p + std::size_t(k);
+                                      double gk = g_radiance.empty() ? 0.0 : double(g_radiance[i]);
+                                      if (!g_colour.empty() && g_colour[i] != 0)
+                                          gk += double(g_colour[i]) * visibility(p) *
+                                                sky_channel_derivative(double(sky.radiance[i]));
+                                      g[k] = gk;
+                                  }
+                                  if (g.x == 0 && g.y == 0 && g.z == 0) continue;
+                                  sky_radiance_vjp(rays[p].cast<double>(), g, env_parts[c],
+                                                   with_residual ? &residual_parts[c] : nullptr);
+                              }
+                      });
     ShCoeffs<double> env{};
     Sh4Coeffs<double> residual{};
     for (std::size_t c = 0; c < chunks; ++c) {

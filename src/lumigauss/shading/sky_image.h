@@ -19,15 +19,24 @@ Vec3d pixel_ray_direction(const Camera& camera, double x, double y);
 // Unit ray directions of every pixel centre, row-major.
 std::vector<Vec3f> pixel_ray_directions(const Camera& camera);
 
-// The sky along every ray: radiance (environment + residual, when given) and display colour.
+// Where the sky ends below: see sky_visibility (sky_colour.h). The default has no horizon.
+struct SkyHorizon {
+    Vec3f up{0, 0, 1};
+    float start_degrees = 0;  // below the horizon, where the sky starts to fade
+    float fade_degrees = 0;   // over how many degrees it fades to 0; 0: the environment is drawn everywhere
+};
+
+// The sky along every ray: radiance (environment + residual, when given), display colour times the ray's
+// visibility (sky_visibility), and that visibility (empty when there is no horizon).
 struct SkyPixels {
-    std::vector<float> radiance, colour;
+    std::vector<float> radiance, colour, visibility;
 };
 void sky_pixels(std::span<const Vec3f> rays, const ShCoeffs<float>& env, const Sh4Coeffs<float>* residual,
-                SkyPixels& out);
+                SkyPixels& out, const SkyHorizon& horizon = {});
 
 // The sky colour of a whole view as an image.
-Image sky_image(const Camera& camera, const ShCoeffs<float>& env, const Sh4Coeffs<float>* residual = nullptr);
+Image sky_image(const Camera& camera, const ShCoeffs<float>& env, const Sh4Coeffs<float>* residual = nullptr,
+                const SkyHorizon& horizon = {});
 
 struct SkyGrads {
     ShCoeffs<float> env;

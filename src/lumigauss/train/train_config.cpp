@@ -85,6 +85,8 @@ constexpr std::array kFields = {
     LUMIGAUSS_FIELD(faithful_radii_reset),
     LUMIGAUSS_FIELD(init_normals_from_points),
     LUMIGAUSS_FIELD(sky_background),
+    LUMIGAUSS_FIELD(sky_horizon_start),
+    LUMIGAUSS_FIELD(sky_horizon_fade),
     LUMIGAUSS_FIELD(sky_residual),
     LUMIGAUSS_FIELD(lambda_sky_residual),
     LUMIGAUSS_FIELD(lr_sky_residual),
@@ -378,6 +380,12 @@ void shrink_schedule(TrainConfig& config) {
 void add_improvements(TrainConfig& config) {
     config.init_normals_from_points = true;
     config.sky_background = true;
+    // Holes in the ground are no longer painted by the light (plaza, demo and temple scenes, 5 runs:
+    // shadowed gt-env PSNR +0.13 to +0.88 dB, uncovered pixels 13-20 % -> 6-14 %). The sky fades only 4 deg
+    // below the horizon: with no margin, surfels hovering at the scene's rim took over the far ground just
+    // below it (demo scene: 19 % of the test views' sky covered, normals 40 deg off).
+    config.sky_horizon_start = 4.0;
+    config.sky_horizon_fade = 4.0;
     config.lambda_sky_alpha = 0.1;
     config.sky_free_regularizers = true;
     config.lambda_background_alpha = 0.1;
@@ -581,6 +589,10 @@ void validate_train_config(const TrainConfig& c) {
     for (const auto& [key, value] : more_weights) require(value >= 0.0, key, value, "must be >= 0");
     require(c.sky_mask_erosion >= 0 && c.sky_mask_erosion <= 16, "sky_mask_erosion", c.sky_mask_erosion,
             "must be in [0, 16] pixels");
+    require(c.sky_horizon_start >= 0.0 && c.sky_horizon_start <= 90.0, "sky_horizon_start",
+            c.sky_horizon_start, "must be in [0, 90] degrees");
+    require(c.sky_horizon_fade >= 0.0 && c.sky_horizon_start + c.sky_horizon_fade <= 90.0, "sky_horizon_fade",
+            c.sky_horizon_fade, "must be >= 0 with sky_horizon_start + sky_horizon_fade <= 90 degrees");
     require(c.background_match_tolerance > 0.0, "background_match_tolerance", c.background_match_tolerance,
             "must be > 0");
     require(c.background_alpha_from >= 0, "background_alpha_from", c.background_alpha_from, "must be >= 0");

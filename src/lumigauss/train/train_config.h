@@ -83,6 +83,13 @@ struct TrainConfig {
     bool init_normals_from_points = false;
     // The photo's environment is drawn behind the surfels (colour += T_final * sky, shading/sky_colour.h).
     bool sky_background = false;
+    // The sky ends below the horizon of the cameras' mean up direction: it starts to fade
+    // sky_horizon_start degrees below it and is gone sky_horizon_fade degrees further down
+    // (shading/sky_colour.h, sky_visibility); fade 0 = the environment is drawn in every direction. An
+    // uncovered pixel well below the horizon is a hole in the ground: shown the environment's unconstrained
+    // lower half, holes were painted by it and the learned lights grew a bright floor.
+    double sky_horizon_start = 0.0;
+    double sky_horizon_fade = 0.0;
     // Where sky masks exist: alpha pushed to 0 on sky pixels (mean alpha over the sky mask eroded by
     // sky_mask_erosion pixels), the environment supervised by the sky pixels it must reproduce (L1 plus
     // 0.1 x (1 - cosine) per pixel, saturated pixels skipped), and the normal/distortion losses kept off the

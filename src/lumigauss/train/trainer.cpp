@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/io/image_metrics.h"
 #include "lumigauss/io/scene_extent.h"
 #include "lumigauss/render/background.h"
@@ -228,7 +229,7 @@ void Trainer::prepare_view_masks() {
     const TrainConfig& c = state_.config;
     const bool object_masks = c.mask_mode == "object";
     masks_.assign(views_.size(), ViewMasks{});
-    Vec3d up{0, 0, 0};
+    std::vector<Mat3d> rotations;
     for (std::size_t v = 0; v < views_.size(); ++v) {
         const TrainView& view = views_[v];
         ViewMasks& m = masks_[v];
@@ -249,9 +250,15 @@ void Trainer::prepare_view_masks() {
         } else {
             m.empty = m.sky;
         }
-        up = up - view.camera.rotation.row(1);  // the camera's -y is its up
+        rotations.push_back(view.camera.rotation);
     }
-    if (length(up) > 0) up_ = ((1.0 / length(up)) * up).cast<float>();
+    const Vec3d up = mean_camera_up(rotations);
+    if (length(up) > 0) up_ = up.cast<float>();
+}
+
+SkyHorizon Trainer::sky_horizon() const {
+    const TrainConfig& c = state_.config;
+    return {up_, float(c.sky_horizon_start), float(c.sky_horizon_fade)};
 }
 
 void Trainer::set_backend(RasterBackend backend) {
@@ -338,7 +345,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     if (residual) sky_residual = state_.sky_residuals.get(report.view);
     if (c.sky_background) {
         s.rays = pixel_ray_directions(view.camera);
-        sky_pixels(s.rays, env, residual ? &sky_residual : nullptr, s.sky);
+        sky_pixels(s.rays, env, residual ? &sky_residual : nullptr, s.sky, sky_horizon());
         for (int first : colour_sets) composite_background<float>(s.images, s.sky.colour, first);
     }
     times_.raster_forward += seconds_since(t0);

@@ -19,6 +19,7 @@
 #include "lumigauss/model/view_shading.h"
 #include "lumigauss/render/raster_types.h"
 #include "lumigauss/render/rasterizer.h"
+#include "lumigauss/shading/sky_image.h"
 #include "lumigauss/train/adam.h"
 #include "lumigauss/train/gaussian_model.h"
 #include "lumigauss/train/train_config.h"
@@ -105,6 +106,9 @@ class Trainer {
     const TrainState& state() const { return state_; }
     TrainState& state() { return state_; }
     const std::vector<TrainView>& views() const { return views_; }
+    // Where the sky drawn behind the surfels ends below the horizon (config sky_horizon_*; the cameras'
+    // mean up).
+    SkyHorizon sky_horizon() const;
     // The training view used at a given iteration (a fresh permutation of the photos per epoch).
     int view_for_iteration(std::int64_t iteration) const;
 

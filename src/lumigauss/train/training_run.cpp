@@ -200,7 +200,8 @@ Image preview_image(const Trainer& trainer, int v) {
     if (st.config.sky_background) {
         const Sh4Coeffs<float> residual =
             st.sky_residuals.empty() ? Sh4Coeffs<float>{} : st.sky_residuals.get(v);
-        const Image sky = sky_image(view.camera, env, st.sky_residuals.empty() ? nullptr : &residual);
+        const Image sky = sky_image(view.camera, env, st.sky_residuals.empty() ? nullptr : &residual,
+                                    trainer.sky_horizon());
         for (int first : {kShadowedOffset, kUnshadowedOffset})
             composite_background<float>(img, sky.pixels, first);
     }

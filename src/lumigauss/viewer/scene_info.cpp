@@ -64,6 +64,7 @@ ViewerScene describe_scene(const TrainedRun& run, const std::vector<ResolvedLigh
     scene.up = up;
     scene.camera = std::move(camera);
     scene.sky_background = run.sky_background;
+    scene.sky_horizon = run.sky_horizon;
     model_extent(run.model, scene);
     for (const ResolvedLight& l : extra_lights)
         scene.lights.push_back({light_name(l), light_kind_name(l.kind), l.sh});
@@ -93,6 +94,11 @@ std::string scene_json(const ViewerScene& scene) {
               {"lights", lights},
               {"initial_light", 0},
               {"sky_background", scene.sky_background}};
+    const SkyHorizon& h = scene.sky_horizon;
+    j["sky_horizon"] = h.fade_degrees > 0 ? json{{"up", vec_json(h.up.cast<double>())},
+                                                 {"start_degrees", h.start_degrees},
+                                                 {"fade_degrees", h.fade_degrees}}
+                                          : json(nullptr);
     return j.dump();
 }
 

@@ -39,6 +39,7 @@ struct ViewerScene {
     std::optional<Camera> camera;  // the initial view when known (--scene, --camera)
     std::vector<ViewerLight> lights;
     bool sky_background = false;  // the run was trained with its sky drawn behind the surfels
+    SkyHorizon sky_horizon;       // where that sky ends below the horizon (no fade: nowhere)
 };
 
 // The uniform environment: radiance 1 / pi in every direction, so irradiance(L, n) = 1 for every n.
