@@ -14,10 +14,13 @@
 #include "lumigauss/eval/gt_env.h"
 #include "lumigauss/eval/report.h"
 #include "lumigauss/io/dataset.h"
+#include "lumigauss/io/image.h"
 #include "lumigauss/model/lighting_mlp.h"
 #include "lumigauss/model/relightable_ply.h"
+#include "lumigauss/relight/relit_sky.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/sh_text.h"
+#include "lumigauss/shading/sky_image.h"
 #include "lumigauss/util/error.h"
 #include "synth_test_util.h"
 
@@ -309,6 +312,53 @@ TEST(EvalGtEnv, EmptyPixelsAreCountedOverTheEvaluationMask) {
     EXPECT_FALSE(none.image_scaled) << "no covered training pixel: no image-space light scale";
     for (const GtEnvImageResult& im : none.images) EXPECT_EQ(im.empty_fraction, 1.0) << im.name;
     EXPECT_TRUE(gt_env_metrics_json(none, {"run", root})["mean"].contains("empty"));
+}
+
+// A run trained with its sky behind the surfels is shown over the condition's own panorama (not its
+// degree-2 SH, which rings around a sun), scaled as the light is, and ending below the run's horizon.
+TEST(EvalGtEnv, TheSkyBehindIsTheTruePanoramaAboveTheHorizon) {
+    const std::string& root = tiny_scene();
+    const Dataset scene = load_dataset(root);
+    const GtSceneMeta meta = load_gt_scene_meta(root);
+    RelightableRun empty = oracle_run(root, 0.7);
+    for (float& logit : empty.model.param(ModelParam::Opacity)) logit = -30.0f;
+    empty.sky_background = true;
+    empty.sky_horizon = {{0, 0, 1}, 4, 4};
+    GtEnvOptions opt;
+    opt.image_light_scale = false;
+    const GtEnvResult r = evaluate_gt_env(empty, scene, meta, opt);
+    const std::vector<const View*> views = scene.split(Split::Test);
+    ASSERT_EQ(r.images.size(), views.size());
+    int above = 0, below = 0, differs_from_sh = 0;
+    for (std::size_t i = 0; i < views.size(); ++i) {
+        const GtImageMeta& im = *meta.find(views[i]->name);
+        const Image panorama = read_image(root + "/env/" + im.condition + ".exr");
+        PanoramaSky sky;
+        sky.pixels = &panorama;
+        sky.factor = Vec3d{1, 1, 1} * (r.light.scale * im.exposure);
+        sky.horizon = empty.sky_horizon;
+        const Image expected = panorama_sky_image(views[i]->camera, sky);
+        ShCoeffs<float> env =
+            scaled(load_condition_sh(meta, im.condition), r.light.scale * im.exposure).cast<float>();
+        const Image sh_sky = sky_image(views[i]->camera, env, nullptr, empty.sky_horizon);
+        const Image& shown = r.images[i].panels.shadowed;
+        ASSERT_EQ(shown.pixels.size(), expected.pixels.size());
+        for (std::size_t q = 0; q < shown.pixels.size(); ++q) {
+            EXPECT_NEAR(shown.pixels[q], std::min(1.0f, expected.pixels[q]), 1e-5f) << q;
+            differs_from_sh += std::abs(expected.pixels[q] - sh_sky.pixels[q]) > 0.05f;
+        }
+        for (int y = 0; y < views[i]->camera.height; ++y) {
+            const double z = pixel_ray_direction(views[i]->camera, 10, y).z;
+            if (z > 0.05) above += shown.at(10, y, 0) > 0.0f;
+            if (z < -0.15) {
+                ++below;
+                EXPECT_EQ(shown.at(10, y, 0), 0.0f);
+            }
+        }
+    }
+    EXPECT_GT(above, 0);
+    EXPECT_GT(below, 0);
+    EXPECT_GT(differs_from_sh, 0) << "the panorama and its SH should differ somewhere";
 }
 
 TEST(EvalGtEnv, WorksWithoutGroundTruthImages) {

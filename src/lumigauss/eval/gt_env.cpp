@@ -13,6 +13,7 @@
 #include "lumigauss/math/quaternion.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/relit_render.h"
+#include "lumigauss/relight/relit_sky.h"
 #include "lumigauss/render/raster_maps.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/sh_text.h"
@@ -89,14 +90,34 @@ ShCoeffs<float> scaled_true_env(const GtSceneMeta& meta, const GtImageMeta& im,
     return env;
 }
 
-// The shadowed render of a view under `env`, clamped, with the sky behind it when the run was trained so.
-Image shadowed_panel(const RelightableRun& run, RelitRenderer& renderer, const Camera& camera,
-                     const ShCoeffs<float>& env) {
-    const RasterImages<float>& relit = renderer.render(camera, env);
+// The sky behind a view lit by `scale` x exposure x its condition's true light: the condition's panorama
+// (env/COND.exr or .hdr, the scene's ground truth) when the scene has it, so that the sheets show the sky
+// the photo shows rather than the ringing of its degree-2 SH; else that SH. Either ends below the run's
+// horizon (holes in the ground are not drawn with the true environment's lower half).
+Image true_sky_image(const RelightableRun& run, const GtSceneMeta& meta, const GtImageMeta& im,
+                     const Camera& camera, const std::array<double, 3>& scale) {
+    for (const char* ext : {".exr", ".hdr"}) {
+        const std::string path = meta.root + "/env/" + im.condition + ext;
+        if (!fs::exists(path)) continue;
+        const Image panorama = read_image(path);
+        PanoramaSky sky;
+        sky.pixels = &panorama;
+        sky.factor = im.exposure * Vec3d{scale[0], scale[1], scale[2]};
+        sky.horizon = run.sky_horizon;
+        return panorama_sky_image(camera, sky);
+    }
+    return sky_image(camera, scaled_true_env(meta, im, scale), nullptr, run.sky_horizon);
+}
+
+// The shadowed render of a view under scale x exposure x its true light, clamped, with the sky behind it
+// when the run was trained so.
+Image shadowed_panel(const RelightableRun& run, const GtSceneMeta& meta, const GtImageMeta& im,
+                     RelitRenderer& renderer, const Camera& camera, const std::array<double, 3>& scale) {
+    const RasterImages<float>& relit = renderer.render(camera, scaled_true_env(meta, im, scale));
     Image shadowed = raster_channels(relit, kRelitShadowed, 3);
     if (run.sky_background)
-        shadowed = over_background_image(shadowed, alpha_image(relit),
-                                         sky_image(camera, env, nullptr, run.sky_horizon));
+        shadowed =
+            over_background_image(shadowed, alpha_image(relit), true_sky_image(run, meta, im, camera, scale));
     return clamp01(shadowed);
 }
 
@@ -363,7 +384,8 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
         p.shadowed = raster_channels(relit, kRelitShadowed, 3);
         p.unshadowed = raster_channels(relit, kRelitUnshadowed, 3);
         if (run.sky_background) {
-            const Image sky = sky_image(v->camera, env, nullptr, run.sky_horizon);
+            const double k = result.light.scale;
+            const Image sky = true_sky_image(run, meta, *im, v->camera, {k, k, k});
             const Image alpha = alpha_image(relit);
             p.shadowed = over_background_image(p.shadowed, alpha, sky);
             p.unshadowed = over_background_image(p.unshadowed, alpha, sky);
@@ -441,8 +463,7 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
         // The same view under the image-space light scale (a second render: the sky and the clamp follow it).
         if (result.image_scaled)
             r.image_scaled_shadowed =
-                image_metrics(shadowed_panel(run, renderer, v->camera,
-                                             scaled_true_env(meta, *im, result.image_light_scale)),
+                image_metrics(shadowed_panel(run, meta, *im, renderer, v->camera, result.image_light_scale),
                               p.truth, p.mask, options.ssim);
         result.images.push_back(std::move(r));
     }
@@ -529,6 +550,8 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
                                             ? result.mean_covered_shadowed_psnr / double(covered_images)
                                             : std::numeric_limits<double>::quiet_NaN();
     result.has_sky = sky_pixels > 0;
+    result.sky_behind = run.sky_background;
+    result.sky_horizon = run.sky_horizon;
     result.sky_alpha_fraction = result.has_sky ? sky_covered / double(sky_pixels) : 0.0;
     std::vector<double> render_ms;
     for (const GtEnvImageResult& r : result.images) render_ms.push_back(r.render_ms);

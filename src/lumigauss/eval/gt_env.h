@@ -177,7 +177,9 @@ struct GtEnvResult {
     bool image_scaled = false;  // step 8 ran (GtEnvOptions::image_light_scale) and found usable pixels
     std::array<double, 3> image_light_scale{1, 1, 1};  // its k per channel
     int downscale = 1;
-    bool gt_mask = false;                         // every test image had a gt/mask
+    bool sky_behind = false;  // the run was trained with its sky behind the surfels: drawn (true_sky_image)
+    SkyHorizon sky_horizon;   // ... above this horizon
+    bool gt_mask = false;     // every test image had a gt/mask
     bool has_albedo = false, has_normal = false;  // every test image had gt/albedo, gt/normal
     std::vector<GtEnvImageResult> images;
     // Means over images (PSNR averaged as PSNR, as officially).

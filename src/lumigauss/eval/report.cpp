@@ -255,6 +255,17 @@ std::string gt_env_report_markdown(const GtEnvResult& r, const ReportSources& sr
          "their learned SH and `k * exposure * true SH` (SH coefficients weighted by A_l^2). Relative "
          "residual " +
          fmt("%.3f", r.light.relative_residual) + ".\n";
+    if (r.sky_behind) {
+        s += "- The run was trained with its sky behind the surfels: renders are drawn over the condition's "
+             "panorama (`env/COND.exr`; its SH where there is none) times `k * exposure`";
+        const SkyHorizon& h = r.sky_horizon;
+        if (h.fade_degrees > 0)
+            s += ", fading out from " + fmt("%.3g", h.start_degrees) + " to " +
+                 fmt("%.3g", h.start_degrees + h.fade_degrees) +
+                 " deg below the horizon of the training cameras' mean up, as in training (a hole in the "
+                 "ground is not filled with the true environment's lower half)";
+        s += ".\n";
+    }
     s += "- The test photo's exposure (meta.json) is applied: it is the camera's setting, recorded with the "
          "photo, not lighting (1.0 for the test photos of data/plaza and `lumigauss synth`).\n";
     s += std::string("- Mask: ") +

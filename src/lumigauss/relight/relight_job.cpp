@@ -127,8 +127,8 @@ Image frame_sky(const Camera& camera, const RelightSummary& summary, const Train
                 const ShCoeffs<float>& env, const Mat3d& frame, double degrees) {
     const ResolvedLight& light = summary.light;
     if (light.kind == LightKind::Panorama && !light.panorama.pixels.empty())
-        return panorama_sky_image(camera,
-                                  {&light.panorama, frame, summary.light_factor, summary.up, degrees});
+        return panorama_sky_image(
+            camera, {&light.panorama, frame, Vec3d{1, 1, 1} * summary.light_factor, summary.up, degrees, {}});
     if (light.kind == LightKind::Photo && degrees == 0 && !run.sky_residuals.empty() &&
         light.photo_index >= 0 && light.photo_index < run.sky_residuals.num_images()) {
         Sh4Coeffs<float> residual = run.sky_residuals.get(light.photo_index);

@@ -38,13 +38,17 @@ Vec3d sample_equirect(const Image& pano, double row, double col) {
 Image panorama_sky_image(const Camera& camera, const PanoramaSky& sky) {
     Image out(camera.width, camera.height, 3);
     const double radians = -sky.degrees * std::numbers::pi / 180.0;
+    const std::vector<float> visibility = sky_visibility_image(camera, sky.horizon);
     for (int y = 0; y < camera.height; ++y)
         for (int x = 0; x < camera.width; ++x) {
-            const Vec3d d = rotated(pixel_ray_direction(camera, x, y), sky.up, radians);
+            const Vec3d ray = pixel_ray_direction(camera, x, y);
+            const Vec3d d = rotated(ray, sky.up, radians);
             const EquirectCoord e =
                 direction_to_equirect(d, sky.pixels->width, sky.pixels->height, sky.frame);
-            const Vec3d radiance = sky.factor * sample_equirect(*sky.pixels, e.row, e.col);
-            for (int c = 0; c < 3; ++c) out.at(x, y, c) = float(sky_channel(radiance[c]));
+            const Vec3d radiance = sample_equirect(*sky.pixels, e.row, e.col);
+            const float visible = visibility.empty() ? 1.0f : visibility[std::size_t(y * camera.width + x)];
+            for (int c = 0; c < 3; ++c)
+                out.at(x, y, c) = visible * float(sky_channel(sky.factor[c] * radiance[c]));
         }
     return out;
 }

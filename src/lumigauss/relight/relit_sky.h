@@ -8,18 +8,21 @@
 #include "lumigauss/math/vec.h"
 #include "lumigauss/shading/sh.h"
 #include "lumigauss/shading/sh_degree4.h"
+#include "lumigauss/shading/sky_image.h"
 
 namespace lumigauss {
 
 struct PanoramaSky {
     const Image* pixels = nullptr;    // equirectangular radiance (shading/envmap.h)
     Mat3d frame = Mat3d::identity();  // world direction = frame * panorama direction
-    double factor = 1.0;              // the light's scale (--exposure, --match-exposure)
+    Vec3d factor{1, 1, 1};            // the light's scale per channel (--exposure, --match-exposure)
     Vec3d up{0, 0, 1};
     double degrees = 0;  // the environment turned about `up` (counter-clockwise seen from above)
+    SkyHorizon horizon;  // where the sky ends below the horizon (none by default: drawn as it is)
 };
 
-// sky_channel(factor * pano(R(-degrees) d)) per pixel, bilinear in the panorama (columns wrap).
+// sky_visibility * sky_channel(factor * pano(R(-degrees) d)) per pixel, bilinear in the panorama (columns
+// wrap).
 Image panorama_sky_image(const Camera& camera, const PanoramaSky& sky);
 
 // A point of an equirectangular image, bilinear; columns wrap around, rows clamp.

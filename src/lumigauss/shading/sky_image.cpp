@@ -15,6 +15,21 @@ namespace {
 
 constexpr std::size_t kChunk = 4096;  // rays per task and per partial sum of the backward
 
+struct HorizonSines {
+    Vec3f up;
+    float start, end;
+};
+
+HorizonSines horizon_sines(const SkyHorizon& horizon) {
+    const auto sine = [](double degrees) {
+        return float(std::sin(std::clamp(degrees, 0.0, 90.0) * std::numbers::pi / 180.0));
+    };
+    const float up_length = length(horizon.up);
+    if (!(up_length > 0)) throw Error("sky horizon: the up direction is zero");
+    return {(1.0f / up_length) * horizon.up, sine(double(horizon.start_degrees)),
+            sine(double(horizon.start_degrees) + double(horizon.fade_degrees))};
+}
+
 }  // namespace
 
 Vec3d pixel_ray_direction(const Camera& camera, double x, double y) {
@@ -34,24 +49,28 @@ std::vector<Vec3f> pixel_ray_directions(const Camera& camera) {
     return rays;
 }
 
+std::vector<float> sky_visibility_image(const Camera& camera, const SkyHorizon& horizon) {
+    if (!(horizon.fade_degrees > 0)) return {};
+    const HorizonSines h = horizon_sines(horizon);
+    const std::vector<Vec3f> rays = pixel_ray_directions(camera);
+    std::vector<float> out(rays.size());
+    for (std::size_t p = 0; p < rays.size(); ++p) out[p] = sky_visibility(h.up, h.start, h.end, rays[p]);
+    return out;
+}
+
 void sky_pixels(std::span<const Vec3f> rays, const ShCoeffs<float>& env, const Sh4Coeffs<float>* residual,
                 SkyPixels& out, const SkyHorizon& horizon) {
     out.radiance.resize(3 * rays.size());
     out.colour.resize(3 * rays.size());
     const bool has_horizon = horizon.fade_degrees > 0;
     out.visibility.resize(has_horizon ? rays.size() : 0);
-    const auto sine = [](double degrees) { return float(std::sin(degrees * std::numbers::pi / 180.0)); };
-    const float start_sine = sine(std::clamp(double(horizon.start_degrees), 0.0, 90.0));
-    const float end_sine = sine(std::clamp(double(horizon.start_degrees + horizon.fade_degrees), 0.0, 90.0));
-    const float up_length = length(horizon.up);
-    if (has_horizon && !(up_length > 0)) throw Error("sky_pixels: the horizon's up direction is zero");
-    const Vec3f up = (1.0f / up_length) * horizon.up;
+    const HorizonSines h = has_horizon ? horizon_sines(horizon) : HorizonSines{{0, 0, 1}, 0, 0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), kChunk),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                           for (std::size_t p = r.begin(); p < r.end(); ++p) {
                               const Vec3f radiance = sky_radiance(env, residual, rays[p]);
                               const float visible =
-                                  has_horizon ? sky_visibility(up, start_sine, end_sine, rays[p]) : 1.0f;
+                                  has_horizon ? sky_visibility(h.up, h.start, h.end, rays[p]) : 1.0f;
                               if (has_horizon) out.visibility[p] = visible;
                               const Vec3f colour = visible * sky_colour_of(radiance);
                               for (int c = 0; c < 3; ++c) {

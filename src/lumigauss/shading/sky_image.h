@@ -34,6 +34,9 @@ struct SkyPixels {
 void sky_pixels(std::span<const Vec3f> rays, const ShCoeffs<float>& env, const Sh4Coeffs<float>* residual,
                 SkyPixels& out, const SkyHorizon& horizon = {});
 
+// Every pixel's sky_visibility under `horizon`, row-major; empty when it has no fade (all visible).
+std::vector<float> sky_visibility_image(const Camera& camera, const SkyHorizon& horizon);
+
 // The sky colour of a whole view as an image.
 Image sky_image(const Camera& camera, const ShCoeffs<float>& env, const Sh4Coeffs<float>* residual = nullptr,
                 const SkyHorizon& horizon = {});
