@@ -149,6 +149,16 @@ int run_train(const TrainFlags& f) {
                 "shadowed renders and shadows are not trained\n",
                 (long long)config.iterations, (long long)config.start_shadowed + 1);
     }
+    if (!run.resumed() && config.ground_seeds) {
+        const GroundSeeds& g = trainer.ground();
+        if (g.found)
+            std::printf(
+                "train: ground plane %.4g along the cameras' up, %zu SfM points on it: %zu starting points "
+                "added where it is bare (grid %.3g)\n",
+                g.height, g.ground_points, g.xyz.size(), g.spacing);
+        else
+            std::printf("train: no ground plane under the cameras in the SfM points: no ground seeds\n");
+    }
     if (run.cameras_fitted_to_photos() > 0)
         std::printf(
             "train: %zu photos are smaller than their COLMAP camera (same aspect ratio): their "

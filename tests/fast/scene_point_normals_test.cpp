@@ -27,6 +27,25 @@ TEST(PointNormals, SmallestEigenvectorOfKnownMatrices) {
     EXPECT_NEAR(std::abs(dot(e, r.col(1))), 1.0, 1e-9);
 }
 
+TEST(PointNormals, SymmetricEigenSolvesTheEigenEquationInAscendingOrder) {
+    const Mat3d r = rotation_from_unit_quaternion(normalize_quaternion(Vec4<double>{0.3, -0.5, 0.2, 0.7}));
+    const double l[3] = {4, -1, 0.5};
+    Mat3d a{};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            for (int k = 0; k < 3; ++k) a(i, j) += r(i, k) * l[k] * r(j, k);
+    const SymmetricEigen e = symmetric_eigen(a);
+    EXPECT_NEAR(e.values[0], -1, 1e-10);
+    EXPECT_NEAR(e.values[1], 0.5, 1e-10);
+    EXPECT_NEAR(e.values[2], 4, 1e-10);
+    for (int i = 0; i < 3; ++i) {
+        const Vec3d av = a * e.vectors[std::size_t(i)];
+        for (int k = 0; k < 3; ++k)
+            EXPECT_NEAR(av[k], e.values[std::size_t(i)] * e.vectors[std::size_t(i)][k], 1e-9);
+        EXPECT_NEAR(length(e.vectors[std::size_t(i)]), 1.0, 1e-12);
+    }
+}
+
 TEST(PointNormals, QuaternionTurnsZOntoTheNormal) {
     for (const Vec3d n : {Vec3d{0, 0, 1}, Vec3d{0, 0, -1}, Vec3d{1, 0, 0}, Vec3d{0.3, -0.4, 0.866}}) {
         const Vec3d u = (1.0 / length(n)) * n;

@@ -117,6 +117,7 @@ std::vector<MemberChange> every_member() {
         {"faithful_radii_reset", [](TrainConfig& c) { c.faithful_radii_reset = false; }},
         {"init_normals_from_points", [](TrainConfig& c) { c.init_normals_from_points = true; }},
         {"sky_background", [](TrainConfig& c) { c.sky_background = true; }},
+        {"ground_seeds", [](TrainConfig& c) { c.ground_seeds = true; }},
         {"sky_horizon_start", [](TrainConfig& c) { c.sky_horizon_start = 2; }},
         {"sky_horizon_fade", [](TrainConfig& c) { c.sky_horizon_fade = 5; }},
         {"sky_residual", [](TrainConfig& c) { c.sky_residual = true; }},
@@ -231,9 +232,9 @@ TEST(TrainConfigPreset, PaperFastShrinksTheScheduleOnly) {
 // The default presets are the paper's (and paper-fast's) plus the improvements of issue #25, each a key.
 TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
     const std::set<std::string> improvements = {
-        "init_normals_from_points", "sky_background",  "lambda_sky_alpha",      "sky_free_regularizers",
-        "lambda_background_alpha",  "prune_until_end", "densify_near_fraction", "downscale",
-        "sky_horizon_start",        "sky_horizon_fade"};
+        "init_normals_from_points", "sky_background",   "lambda_sky_alpha",      "sky_free_regularizers",
+        "lambda_background_alpha",  "prune_until_end",  "densify_near_fraction", "downscale",
+        "sky_horizon_start",        "sky_horizon_fade", "ground_seeds"};
     for (const auto& [improved, base] : {std::pair{"default", "paper"}, std::pair{"fast", "paper-fast"}}) {
         SCOPED_TRACE(improved);
         const Json a = Json::parse(train_config_to_json(train_preset(improved)));
@@ -252,6 +253,7 @@ TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
     EXPECT_EQ(paper.lambda_sky_alpha, 0.0);
     EXPECT_EQ(paper.lambda_background_alpha, 0.0);
     EXPECT_EQ(paper.sky_horizon_fade, 0.0);
+    EXPECT_FALSE(paper.ground_seeds);
 }
 
 TEST(TrainConfigPreset, EveryPresetValidates) {
@@ -275,7 +277,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 62, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 63, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "lumigauss/math/symmetric_eigen.h"
 #include "lumigauss/shading/sh_rotation.h"
 #include "lumigauss/util/error.h"
 
@@ -23,12 +24,24 @@ Vec3d parse_up_axis(const std::string& text) {
     throw Error("up axis '" + text + "': expected one of +x, -x, +y, -y, +z, -z (or auto)");
 }
 
-Vec3d mean_camera_up(const std::vector<Mat3d>& world_to_camera) {
+Vec3d camera_up_direction(const std::vector<Mat3d>& world_to_camera) {
     Vec3d mean{};
-    for (const Mat3d& r : world_to_camera) mean += -r.row(1);
-    const double n = length(mean);
-    if (!(n > 1e-9 * double(world_to_camera.size()))) return {};
-    return (1.0 / n) * mean;
+    Mat3d scatter{};
+    for (const Mat3d& r : world_to_camera) {
+        mean += -r.row(1);
+        const Vec3d x = r.row(0);
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) scatter(i, j) += x[i] * x[j];
+    }
+    const double n = double(world_to_camera.size());
+    if (!(length(mean) > 1e-9 * n)) return {};
+    const SymmetricEigen e = symmetric_eigen(scatter);
+    // Level x axes in at least two directions: the second eigenvalue is a real share of the scatter (an
+    // x axis turned by t from the first direction adds sin^2 t).
+    Vec3d up = e.values[1] > 0.05 * n ? e.vectors[0] : mean - dot(mean, e.vectors[2]) * e.vectors[2];
+    if (!(length(up) > 1e-9)) return {};
+    up = normalize(up);
+    return dot(up, mean) < 0 ? -1.0 * up : up;
 }
 
 Vec3d estimate_up_axis(const std::vector<Camera>& cameras) {

@@ -15,10 +15,13 @@ namespace lumigauss {
 // "x", "+x", "-x", ... "-z" (case-insensitive) -> the unit vector. Throws Error on anything else.
 Vec3d parse_up_axis(const std::string& text);
 
-// The unit mean of the world up vectors -(row 1 of R) of world-to-camera rotations (the cameras' -y), or
-// zero when there is none or they cancel out. Photos are taken roughly level, so this is the world's up
-// direction where the horizon lies (not rounded to an axis).
-Vec3d mean_camera_up(const std::vector<Mat3d>& world_to_camera);
+// The world's up direction from world-to-camera rotations (not rounded to an axis), for the horizon: photos
+// are taken level, with their x axes (row 0 of R) horizontal even when they look up at a building, so up is
+// the direction every x axis is perpendicular to (the smallest eigenvector of sum x x^T), signed along the
+// cameras' mean -y. The mean -y itself tilts by the cameras' mean pitch (4 deg on the demo scene, whose
+// photos mostly face one side). When the x axes do not pin it (all photos face one way), the mean -y
+// without its part along them. Zero when there is no rotation or the mean -y vanishes.
+Vec3d camera_up_direction(const std::vector<Mat3d>& world_to_camera);
 
 // The signed coordinate axis closest to the mean world up vector (-(row 1 of R), the camera's -y) of the
 // cameras. Throws Error when there is no camera or the mean vanishes.

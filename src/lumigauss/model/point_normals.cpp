@@ -8,37 +8,6 @@
 
 namespace lumigauss {
 
-Vec3d smallest_eigenvector(const Mat3d& symmetric) {
-    // Cyclic Jacobi: rotate away the largest off-diagonal entry until the matrix is diagonal; the columns of
-    // the accumulated rotation are the eigenvectors.
-    Mat3d a = symmetric, v = Mat3d::identity();
-    for (int sweep = 0; sweep < 32; ++sweep) {
-        int p = 0, q = 1;
-        for (const auto& [i, j] : {std::pair{0, 2}, std::pair{1, 2}})
-            if (std::abs(a(i, j)) > std::abs(a(p, q))) p = i, q = j;
-        const double scale = std::abs(a(0, 0)) + std::abs(a(1, 1)) + std::abs(a(2, 2));
-        if (!(std::abs(a(p, q)) > 1e-15 * scale)) break;
-        const double theta = 0.5 * std::atan2(2 * a(p, q), a(q, q) - a(p, p));
-        const double c = std::cos(theta), s = std::sin(theta);
-        Mat3d r = Mat3d::identity();
-        r(p, p) = c, r(q, q) = c, r(p, q) = s, r(q, p) = -s;
-        // a <- r^T a r, v <- v r
-        Mat3d ar{}, next{}, vr{};
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-                for (int k = 0; k < 3; ++k) ar(i, j) += a(i, k) * r(k, j), vr(i, j) += v(i, k) * r(k, j);
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-                for (int k = 0; k < 3; ++k) next(i, j) += r(k, i) * ar(k, j);
-        a = next, v = vr;
-    }
-    int smallest = 0;
-    for (int i = 1; i < 3; ++i)
-        if (a(i, i) < a(smallest, smallest)) smallest = i;
-    const Vec3d e = v.col(smallest);
-    return (1.0 / length(e)) * e;
-}
-
 Vec4<double> quaternion_with_normal(Vec3d n) {
     // The shortest rotation taking +z to n: axis z x n, half-angle from 1 + z.n.
     const double w = 1.0 + n.z;

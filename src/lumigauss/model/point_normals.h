@@ -5,6 +5,7 @@
 // lying in the ground plane is seen edge-on from there.
 #include <vector>
 
+#include "lumigauss/math/symmetric_eigen.h"
 #include "lumigauss/math/vec.h"
 
 namespace lumigauss {
@@ -12,9 +13,6 @@ namespace lumigauss {
 // Per point: the unit eigenvector of the smallest eigenvalue of the covariance of the point and its k nearest
 // neighbours (principal component analysis; sign arbitrary). +z where fewer than 3 points exist.
 std::vector<Vec3f> point_normals(const std::vector<Vec3f>& points, int k = 16);
-
-// The smallest eigenvector of a symmetric 3x3 matrix (Jacobi rotations; exact for diagonal input).
-Vec3d smallest_eigenvector(const Mat3d& symmetric);
 
 // A unit quaternion (w, x, y, z) whose rotation's third column is the unit vector n.
 Vec4<double> quaternion_with_normal(Vec3d n);

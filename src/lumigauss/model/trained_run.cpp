@@ -36,7 +36,7 @@ SkyHorizon recorded_sky_horizon(const nlohmann::json& config, const std::string&
             for (int j = 0; j < 3; ++j) r(i, j) = p.rotation[std::size_t(3 * i + j)];
         rotations.push_back(r);
     }
-    const Vec3d up = mean_camera_up(rotations);
+    const Vec3d up = camera_up_direction(rotations);
     if (!(length(up) > 0)) return horizon;
     horizon.up = up.cast<float>();
     horizon.start_degrees = float(start);

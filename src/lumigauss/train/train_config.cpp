@@ -84,6 +84,7 @@ constexpr std::array kFields = {
     LUMIGAUSS_FIELD(percent_dense),
     LUMIGAUSS_FIELD(faithful_radii_reset),
     LUMIGAUSS_FIELD(init_normals_from_points),
+    LUMIGAUSS_FIELD(ground_seeds),
     LUMIGAUSS_FIELD(sky_background),
     LUMIGAUSS_FIELD(sky_horizon_start),
     LUMIGAUSS_FIELD(sky_horizon_fade),
@@ -379,6 +380,7 @@ void shrink_schedule(TrainConfig& config) {
 // the ground.
 void add_improvements(TrainConfig& config) {
     config.init_normals_from_points = true;
+    config.ground_seeds = true;
     config.sky_background = true;
     // Holes in the ground are no longer painted by the light (plaza, demo and temple scenes, 5 runs:
     // shadowed gt-env PSNR +0.13 to +0.88 dB, uncovered pixels 13-20 % -> 6-14 %). The sky fades only 4 deg

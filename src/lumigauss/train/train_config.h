@@ -81,6 +81,9 @@ struct TrainConfig {
     // Beyond the paper (issue #25): each switched off here (the paper preset), on in the default presets.
     // Surfels start in the plane of their SfM neighbourhood instead of randomly turned (point_normals.h).
     bool init_normals_from_points = false;
+    // More starting points on the ground plane under the cameras, where the SfM points leave it bare
+    // (train/ground_seeds.h).
+    bool ground_seeds = false;
     // The photo's environment is drawn behind the surfels (colour += T_final * sky, shading/sky_colour.h).
     bool sky_background = false;
     // The sky ends below the horizon of the cameras' mean up direction: it starts to fade

@@ -182,7 +182,17 @@ Trainer::Trainer(std::vector<TrainView> views, const std::vector<Vec3f>& point_x
     for (std::size_t i = 0; i < views_.size(); ++i) cams[i].camera = views_[i].camera;
     state_.scene_extent = camera_extent(cams).radius;
     for (const auto& v : views_) state_.image_names.push_back(v.name);
-    state_.model = GaussianModel::from_points(point_xyz, point_rgb, state_.scene_extent, config.seed,
+    std::vector<Vec3f> xyz = point_xyz, rgb = point_rgb;
+    if (config.ground_seeds) {
+        std::vector<Vec3d> centres;
+        std::vector<Mat3d> rotations;
+        for (const TrainView& v : views_)
+            centres.push_back(v.camera.center()), rotations.push_back(v.camera.rotation);
+        ground_ = ground_seeds(point_xyz, point_rgb, centres, camera_up_direction(rotations), state_.scene_extent);
+        xyz.insert(xyz.end(), ground_.xyz.begin(), ground_.xyz.end());
+        rgb.insert(rgb.end(), ground_.rgb.begin(), ground_.rgb.end());
+    }
+    state_.model = GaussianModel::from_points(xyz, rgb, state_.scene_extent, config.seed,
                                               model_learning_rates(config), config.init_normals_from_points);
     state_.lighting = LightingMlp(int(views_.size()), std::uint32_t(config.seed));
     if (config.lighting_init_radiance > 0) {
@@ -252,7 +262,7 @@ void Trainer::prepare_view_masks() {
         }
         rotations.push_back(view.camera.rotation);
     }
-    const Vec3d up = mean_camera_up(rotations);
+    const Vec3d up = camera_up_direction(rotations);
     if (length(up) > 0) up_ = up.cast<float>();
 }
 

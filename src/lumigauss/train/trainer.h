@@ -22,6 +22,7 @@
 #include "lumigauss/shading/sky_image.h"
 #include "lumigauss/train/adam.h"
 #include "lumigauss/train/gaussian_model.h"
+#include "lumigauss/train/ground_seeds.h"
 #include "lumigauss/train/train_config.h"
 
 namespace lumigauss {
@@ -106,6 +107,9 @@ class Trainer {
     const TrainState& state() const { return state_; }
     TrainState& state() { return state_; }
     const std::vector<TrainView>& views() const { return views_; }
+    // The ground seeds added to the SfM points at the start (config ground_seeds; none found or resumed:
+    // found = false and no points).
+    const GroundSeeds& ground() const { return ground_; }
     // Where the sky drawn behind the surfels ends below the horizon (config sky_horizon_*; the cameras'
     // mean up).
     SkyHorizon sky_horizon() const;
@@ -132,6 +136,7 @@ class Trainer {
 
     std::vector<TrainView> views_;
     std::vector<ViewMasks> masks_;  // per view: what the photometric, alpha and regulariser losses act on
+    GroundSeeds ground_;
     Vec3f up_{0, 0, 1};             // the cameras' mean up direction (the horizon of background_alpha)
     TrainState state_;
     std::unique_ptr<Scratch> scratch_;
