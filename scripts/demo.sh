@@ -23,7 +23,10 @@ echo "== 5/6 evaluating novel views under novel lights (gt-env protocol)"
 summary=$("$bin" eval "$out/run" --scene "$out/scene" --protocol gt-env -o "$out/eval" | tee /dev/stderr |
           grep '^eval-summary:')
 echo "== 6/6 relighting the test views under the first sky of the scene, turned in 8 steps"
+# The panorama of the scene's first sky: its own pixels behind the model (a degree-2 SH of a sunny sky rings
+# black away from the sun), its SH for the shading.
 sky=$(ls "$out/scene/env/"*_sh.txt | head -n 1)
+[ -f "${sky%_sh.txt}.exr" ] && sky="${sky%_sh.txt}.exr"
 "$bin" render "$out/run" --scene "$out/scene" --cameras test --light "$sky" --match-exposure --spin 8 \
     --background sky \
     -o "$out/relit"
