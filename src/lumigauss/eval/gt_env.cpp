@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <optional>
@@ -90,18 +91,36 @@ ShCoeffs<float> scaled_true_env(const GtSceneMeta& meta, const GtImageMeta& im,
     return env;
 }
 
+// The conditions' panoramas (env/COND.exr or .hdr, the scene's ground truth), each read once.
+class TruePanoramas {
+  public:
+    explicit TruePanoramas(const GtSceneMeta& meta) : meta_(meta) {}
+    // nullptr when the scene has no panorama of the condition.
+    const Image* find(const std::string& condition) {
+        auto [it, added] = cache_.try_emplace(condition);
+        if (added)
+            for (const char* ext : {".exr", ".hdr"})
+                if (const std::string path = meta_.root + "/env/" + condition + ext; fs::exists(path)) {
+                    it->second = read_image(path);
+                    break;
+                }
+        return it->second ? &*it->second : nullptr;
+    }
+
+  private:
+    const GtSceneMeta& meta_;
+    std::map<std::string, std::optional<Image>> cache_;
+};
+
 // The sky behind a view lit by `scale` x exposure x its condition's true light: the condition's panorama
-// (env/COND.exr or .hdr, the scene's ground truth) when the scene has it, so that the sheets show the sky
-// the photo shows rather than the ringing of its degree-2 SH; else that SH. Either ends below the run's
-// horizon (holes in the ground are not drawn with the true environment's lower half).
-Image true_sky_image(const RelightableRun& run, const GtSceneMeta& meta, const GtImageMeta& im,
-                     const Camera& camera, const std::array<double, 3>& scale) {
-    for (const char* ext : {".exr", ".hdr"}) {
-        const std::string path = meta.root + "/env/" + im.condition + ext;
-        if (!fs::exists(path)) continue;
-        const Image panorama = read_image(path);
+// when the scene has it, so that the sheets show the sky the photo shows rather than the ringing of its
+// degree-2 SH; else that SH. Either ends below the run's horizon (holes in the ground are not drawn with the
+// true environment's lower half).
+Image true_sky_image(const RelightableRun& run, const GtSceneMeta& meta, TruePanoramas& panoramas,
+                     const GtImageMeta& im, const Camera& camera, const std::array<double, 3>& scale) {
+    if (const Image* panorama = panoramas.find(im.condition)) {
         PanoramaSky sky;
-        sky.pixels = &panorama;
+        sky.pixels = panorama;
         sky.factor = im.exposure * Vec3d{scale[0], scale[1], scale[2]};
         sky.horizon = run.sky_horizon;
         return panorama_sky_image(camera, sky);
@@ -111,13 +130,14 @@ Image true_sky_image(const RelightableRun& run, const GtSceneMeta& meta, const G
 
 // The shadowed render of a view under scale x exposure x its true light, clamped, with the sky behind it
 // when the run was trained so.
-Image shadowed_panel(const RelightableRun& run, const GtSceneMeta& meta, const GtImageMeta& im,
-                     RelitRenderer& renderer, const Camera& camera, const std::array<double, 3>& scale) {
+Image shadowed_panel(const RelightableRun& run, const GtSceneMeta& meta, TruePanoramas& panoramas,
+                     const GtImageMeta& im, RelitRenderer& renderer, const Camera& camera,
+                     const std::array<double, 3>& scale) {
     const RasterImages<float>& relit = renderer.render(camera, scaled_true_env(meta, im, scale));
     Image shadowed = raster_channels(relit, kRelitShadowed, 3);
     if (run.sky_background)
-        shadowed =
-            over_background_image(shadowed, alpha_image(relit), true_sky_image(run, meta, im, camera, scale));
+        shadowed = over_background_image(shadowed, alpha_image(relit),
+                                         true_sky_image(run, meta, panoramas, im, camera, scale));
     return clamp01(shadowed);
 }
 
@@ -359,6 +379,7 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
 
     // One pass per view gives both colours, both intensities and the albedo (relight/relit_render.h).
     RelitRenderer renderer(run.model, options.backend);
+    TruePanoramas panoramas(meta);
 
     std::vector<AlbedoInputs> albedo_inputs;
     std::vector<double> pooled_angles;
@@ -385,7 +406,7 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
         p.unshadowed = raster_channels(relit, kRelitUnshadowed, 3);
         if (run.sky_background) {
             const double k = result.light.scale;
-            const Image sky = true_sky_image(run, meta, *im, v->camera, {k, k, k});
+            const Image sky = true_sky_image(run, meta, panoramas, *im, v->camera, {k, k, k});
             const Image alpha = alpha_image(relit);
             p.shadowed = over_background_image(p.shadowed, alpha, sky);
             p.unshadowed = over_background_image(p.unshadowed, alpha, sky);
@@ -462,9 +483,9 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
         }
         // The same view under the image-space light scale (a second render: the sky and the clamp follow it).
         if (result.image_scaled)
-            r.image_scaled_shadowed =
-                image_metrics(shadowed_panel(run, meta, *im, renderer, v->camera, result.image_light_scale),
-                              p.truth, p.mask, options.ssim);
+            r.image_scaled_shadowed = image_metrics(
+                shadowed_panel(run, meta, panoramas, *im, renderer, v->camera, result.image_light_scale),
+                p.truth, p.mask, options.ssim);
         result.images.push_back(std::move(r));
     }
 

@@ -66,6 +66,14 @@ std::vector<AdamGroup> sky_residual_optimizer(const TrainConfig& c, int num_imag
 
 namespace {
 
+// The world's up of the training photos (cameras/up_axis.h); +z when they do not give one.
+Vec3d views_up(const std::vector<TrainView>& views) {
+    std::vector<Mat3d> rotations;
+    for (const TrainView& v : views) rotations.push_back(v.camera.rotation);
+    const Vec3d up = camera_up_direction(rotations);
+    return length(up) > 0 ? up : Vec3d{0, 0, 1};
+}
+
 bool uses_sky_residual(const TrainConfig& c) {
     return c.sky_background && c.sky_residual;
 }
@@ -182,13 +190,13 @@ Trainer::Trainer(std::vector<TrainView> views, const std::vector<Vec3f>& point_x
     for (std::size_t i = 0; i < views_.size(); ++i) cams[i].camera = views_[i].camera;
     state_.scene_extent = camera_extent(cams).radius;
     for (const auto& v : views_) state_.image_names.push_back(v.name);
+    const Vec3d up = views_up(views_);
+    up_ = up.cast<float>();
     std::vector<Vec3f> xyz = point_xyz, rgb = point_rgb;
     if (config.ground_seeds) {
         std::vector<Vec3d> centres;
-        std::vector<Mat3d> rotations;
-        for (const TrainView& v : views_)
-            centres.push_back(v.camera.center()), rotations.push_back(v.camera.rotation);
-        ground_ = ground_seeds(point_xyz, point_rgb, centres, camera_up_direction(rotations), state_.scene_extent);
+        for (const TrainView& v : views_) centres.push_back(v.camera.center());
+        ground_ = ground_seeds(point_xyz, point_rgb, centres, up, state_.scene_extent);
         xyz.insert(xyz.end(), ground_.xyz.begin(), ground_.xyz.end());
         rgb.insert(rgb.end(), ground_.rgb.begin(), ground_.rgb.end());
     }
@@ -232,6 +240,7 @@ Trainer::Trainer(std::vector<TrainView> views, TrainState state)
         throw Error("the saved run has sky residuals for " +
                     std::to_string(state_.sky_residuals.num_images()) + " photos, the dataset has " +
                     std::to_string(views_.size()) + " training photos");
+    up_ = views_up(views_).cast<float>();
     prepare_view_masks();
 }
 
@@ -239,7 +248,6 @@ void Trainer::prepare_view_masks() {
     const TrainConfig& c = state_.config;
     const bool object_masks = c.mask_mode == "object";
     masks_.assign(views_.size(), ViewMasks{});
-    std::vector<Mat3d> rotations;
     for (std::size_t v = 0; v < views_.size(); ++v) {
         const TrainView& view = views_[v];
         ViewMasks& m = masks_[v];
@@ -260,10 +268,7 @@ void Trainer::prepare_view_masks() {
         } else {
             m.empty = m.sky;
         }
-        rotations.push_back(view.camera.rotation);
     }
-    const Vec3d up = camera_up_direction(rotations);
-    if (length(up) > 0) up_ = up.cast<float>();
 }
 
 SkyHorizon Trainer::sky_horizon() const {

@@ -137,7 +137,7 @@ class Trainer {
     std::vector<TrainView> views_;
     std::vector<ViewMasks> masks_;  // per view: what the photometric, alpha and regulariser losses act on
     GroundSeeds ground_;
-    Vec3f up_{0, 0, 1};             // the cameras' mean up direction (the horizon of background_alpha)
+    Vec3f up_{0, 0, 1};  // the photos' up (camera_up_direction): the horizon of the sky, background_alpha
     TrainState state_;
     std::unique_ptr<Scratch> scratch_;
     PhaseTimes times_;
