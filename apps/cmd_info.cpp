@@ -39,6 +39,11 @@ void print_views(const Dataset& d, const std::string& mask_mode) {
     }
     std::printf("downscale:     %d\nresolutions:   %s\n", d.downscale, counted(sizes).c_str());
     std::printf("camera models: %s\n", counted(models).c_str());
+    if (d.undistorted_views() > 0)
+        std::printf(
+            "lens:          %zu views with lens distortion, undistorted as they load onto the pinhole of "
+            "the same intrinsics (pixels the photo does not cover are masked out)\n",
+            d.undistorted_views());
     std::printf("masks:         %d of %zu views", masks, d.views.size());
     if (masks > 0)
         std::printf(", taken as %s\n", mask_mode == "object"

@@ -164,6 +164,11 @@ int run_train(const TrainFlags& f) {
             "train: %zu photos are smaller than their COLMAP camera (same aspect ratio): their "
             "cameras were scaled to them\n",
             run.cameras_fitted_to_photos());
+    if (run.undistorted_photos() > 0)
+        std::printf(
+            "train: %zu photos have lens distortion: undistorted onto their pinhole camera as they load "
+            "(pixels the photo does not cover are masked out)\n",
+            run.undistorted_photos());
     if (run.far_points_dropped() > 0)
         std::printf(
             "train: dropped %zu SfM point(s) more than %.4g from the cameras' centre (1000x their "

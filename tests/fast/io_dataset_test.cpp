@@ -378,19 +378,6 @@ TEST(DatasetErrors, NanInPose) {
     expect_error([&] { load_dataset(tmp.path().string()); }, {"images.bin", "img_0.png", "NaN"});
 }
 
-TEST(DatasetErrors, DistortedCameraIsRefusedWithTheFix) {
-    TempDir tmp;
-    ColmapModel m = test::small_model(2, 8, 6);
-    m.cameras[2] = ColmapCamera{2, "SIMPLE_RADIAL", 8, 6, {25, 4, 3, 0.05}};
-    test::write_scene(tmp.path(), m);
-    expect_error([&] { load_dataset(tmp.path().string()); },
-                 {"cameras.txt", "camera_id 2", "SIMPLE_RADIAL", "colmap image_undistorter"});
-    m.cameras[2] = ColmapCamera{2, "OPENCV_FISHEYE", 8, 6, {25, 25, 4, 3, 0, 0, 0, 0}};
-    write_colmap_text(tmp / "sparse/0", m);
-    expect_error([&] { load_dataset(tmp.path().string()); },
-                 {"camera_id 2", "OPENCV_FISHEYE", "image_undistorter"});
-}
-
 TEST(DatasetErrors, NotASceneAndBadOptions) {
     TempDir tmp;
     expect_error([&] { load_dataset(tmp.path().string()); }, {tmp.path().string(), "not a scene"});

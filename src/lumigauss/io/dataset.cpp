@@ -72,11 +72,14 @@ View finish_view(RawView raw, int factor, std::size_t& fitted) {
     return v;
 }
 
-// The loaded image at the view's resolution, after checking that the file has the size its header had.
+// The loaded image at the view's resolution, after checking that the file has the size its header had:
+// undistorted at the photo's resolution, then downscaled.
 Image fit_to_view(Image image, const View& view, const std::string& path, const char* kind) {
     if (image.width != view.source_width || image.height != view.source_height)
         fail_in_file(path, std::string(kind) + " is " + size_text(image.width, image.height) + " but " +
                                view.name + " needs " + size_text(view.source_width, view.source_height));
+    if (!view.lens.is_identity())
+        image = undistort_image(image, view.camera.resized(view.source_width, view.source_height), view.lens);
     if (image.width == view.camera.width && image.height == view.camera.height) return image;
     return resize_area(image, view.camera.width, view.camera.height);
 }
@@ -104,7 +107,11 @@ Image Dataset::load_image(const View& view) const {
 }
 
 Image Dataset::load_mask(const View& view) const {
-    if (view.mask_path.empty()) return Image(view.camera.width, view.camera.height, 1, 1.0f);
+    if (view.mask_path.empty() && view.lens.is_identity())
+        return Image(view.camera.width, view.camera.height, 1, 1.0f);
+    if (view.mask_path.empty())
+        return fit_to_view(Image(view.source_width, view.source_height, 1, 1.0f), view, view.image_path,
+                           "image");
     return fit_to_view(to_channels(read_image(view.mask_path), 1), view, view.mask_path, "mask");
 }
 
@@ -113,8 +120,21 @@ Image Dataset::load_sky_mask(const View& view) const {
     return fit_to_view(to_channels(read_image(view.sky_mask_path), 1), view, view.sky_mask_path, "sky mask");
 }
 
+Image Dataset::load_coverage(const View& view) const {
+    if (view.lens.is_identity()) return Image();
+    const Image valid =
+        undistort_validity(view.camera.resized(view.source_width, view.source_height), view.lens);
+    if (valid.width == view.camera.width && valid.height == view.camera.height) return valid;
+    return resize_area(valid, view.camera.width, view.camera.height);
+}
+
 bool Dataset::has_sky_masks() const {
     return std::any_of(views.begin(), views.end(), [](const View& v) { return !v.sky_mask_path.empty(); });
+}
+
+std::size_t Dataset::undistorted_views() const {
+    return std::size_t(
+        std::count_if(views.begin(), views.end(), [](const View& v) { return !v.lens.is_identity(); }));
 }
 
 std::vector<const View*> Dataset::split(Split which) const {

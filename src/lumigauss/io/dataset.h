@@ -1,5 +1,5 @@
 #pragma once
-// A scene on disk as views (image path, optional mask path, undistorted pinhole camera, split) plus SfM
+// A scene on disk as views (image path, optional mask path, pinhole camera and lens, split) plus SfM
 // points. Two layouts are recognised (load_dataset sniffs which):
 //   COLMAP:   <root>/sparse/0/ (or <root>/sparse/) with {cameras,images,points3D}.{bin,txt}, <root>/images/,
 //             optional <root>/masks/ (mask of images/a/b.jpg: masks/a/b.<any image extension> or
@@ -21,6 +21,7 @@
 
 #include "lumigauss/io/camera.h"
 #include "lumigauss/io/image.h"
+#include "lumigauss/io/lens_distortion.h"
 #include "lumigauss/math/vec.h"
 
 namespace lumigauss {
@@ -46,6 +47,9 @@ struct View {
     Camera camera;              // at the loaded (downscaled) resolution
     // Where the pinhole came from: the COLMAP model name, or "NERF-OSR K" for NeRF-OSR.
     std::string camera_model;
+    // The photo's lens (COLMAP's SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV); the load_* functions undistort
+    // the image and masks onto `camera`, and load_mask is 0 where the photo does not hold the pixel's ray.
+    LensDistortion lens;
     Split split = Split::Train;
     int source_width = 0, source_height = 0;  // the image file's size, before downscaling
 };
@@ -70,17 +74,24 @@ struct Dataset {
     std::size_t cameras_fitted_to_photos = 0;
     double far_point_limit = 0;  // the distance from the cameras' centroid beyond which they were dropped
 
-    // RGB in [0, 1] (gray is replicated, alpha dropped), resized by the downscale factor. Throws Error naming
+    // RGB in [0, 1] (gray is replicated, alpha dropped), undistorted (View::lens), resized by the downscale
+    // factor. Throws Error naming
     // the file if it cannot be read or its size is not the camera's.
     Image load_image(const View& view) const;
     // One channel in [0, 1] (first channel of the file; 1 = use the pixel), resized like the image. All ones
-    // when the view has no mask. Throws Error naming the mask file if its size differs from the image's.
+    // when the view has no mask (except where undistortion leaves the photo: 0 there). Throws Error naming
+    // the mask file if its size differs from the image's.
     Image load_mask(const View& view) const;
     // One channel in [0, 1], 1 = sky, resized like the image; an empty image when the view has none. Throws
     // Error naming the file if it cannot be read or its size differs from the image's.
     Image load_sky_mask(const View& view) const;
+    // One channel: 1 where the undistorted photo holds the pixel's ray, 0 where it does not (fractions at
+    // the edge after downscaling); an empty image for a view without lens distortion (it covers everything).
+    Image load_coverage(const View& view) const;
     // True when at least one view has a sky mask.
     bool has_sky_masks() const;
+    // How many views have a lens distortion that load_* undistorts.
+    std::size_t undistorted_views() const;
     std::vector<const View*> split(Split which) const;
 };
 

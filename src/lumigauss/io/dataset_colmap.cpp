@@ -6,6 +6,7 @@
 
 #include "lumigauss/io/colmap.h"
 #include "lumigauss/io/dataset_detail.h"
+#include "lumigauss/io/lens_distortion.h"
 #include "lumigauss/io/split_file.h"
 #include "lumigauss/math/quaternion.h"
 #include "lumigauss/util/error.h"
@@ -25,33 +26,23 @@ std::string find_sparse_dir(const std::string& root) {
     return {};
 }
 
-bool all_zero(const std::vector<double>& params, std::size_t first) {
-    return std::all_of(params.begin() + long(first), params.end(), [](double p) { return p == 0.0; });
-}
-
-[[noreturn]] void refuse_distorted(const ColmapCamera& c, const std::string& file, const std::string& why) {
-    fail_in_file(file, "camera_id " + std::to_string(c.id) + " uses the " + c.model + " model " + why +
-                           "; LumiGauss needs undistorted pinhole images. Run `colmap image_undistorter "
-                           "--image_path images --input_path sparse/0 --output_path undistorted` and use the "
-                           "`undistorted` folder as the scene");
-}
-
-// Intrinsics of a pinhole camera. Distortion models are accepted only when every distortion term is zero.
-Camera pinhole_camera(const ColmapCamera& c, const std::string& file) {
+// Intrinsics of the pinhole camera and the lens distortion of a COLMAP camera (io/lens_distortion.h: the
+// photos are undistorted onto that pinhole when they are loaded).
+Camera pinhole_camera(const ColmapCamera& c, const std::string& file, LensDistortion& lens) {
     Camera cam;
     cam.width = c.width, cam.height = c.height;
     const auto& p = c.params;
+    if (!colmap_lens_distortion(c.model, p, lens))
+        fail_in_file(file, "camera_id " + std::to_string(c.id) + " uses the " + c.model +
+                               " model, which LumiGauss does not undistort (it does SIMPLE_RADIAL, RADIAL, "
+                               "OPENCV and FULL_OPENCV). Run `colmap image_undistorter --image_path images "
+                               "--input_path sparse/0 --output_path undistorted` and use the `undistorted` "
+                               "folder as the scene (copy masks/ and sky_masks/ through the same step)");
     const bool one_focal = c.model == "SIMPLE_PINHOLE" || c.model == "SIMPLE_RADIAL" || c.model == "RADIAL";
-    const bool two_focal = c.model == "PINHOLE" || c.model == "OPENCV" || c.model == "FULL_OPENCV";
-    if (one_focal) {
+    if (one_focal)
         cam.fx = cam.fy = p[0], cam.cx = p[1], cam.cy = p[2];
-        if (!all_zero(p, 3)) refuse_distorted(c, file, "with non-zero distortion");
-    } else if (two_focal) {
+    else
         cam.fx = p[0], cam.fy = p[1], cam.cx = p[2], cam.cy = p[3];
-        if (!all_zero(p, 4)) refuse_distorted(c, file, "with non-zero distortion");
-    } else {
-        refuse_distorted(c, file, "(a fisheye model)");
-    }
     if (!(cam.fx > 0 && cam.fy > 0))
         fail_in_file(file, "camera_id " + std::to_string(c.id) + ": focal length must be positive");
     return cam;
@@ -151,7 +142,7 @@ RawView colmap_view(const ColmapImage& im, const ColmapCamera& c, const ColmapFi
     std::error_code ec;
     if (!fs::is_regular_file(r.view.image_path, ec))
         fail_in_file(r.view.image_path, "image listed in " + files.images_file + " is missing");
-    r.view.camera = posed_camera(pinhole_camera(c, files.cameras_file), im);
+    r.view.camera = posed_camera(pinhole_camera(c, files.cameras_file, r.view.lens), im);
     r.view.camera_model = c.model;
     r.camera_origin = files.cameras_file + " camera_id " + std::to_string(c.id);
     return r;

@@ -127,6 +127,7 @@ std::vector<TrainView> load_train_views(const Dataset& dataset) {
         t.rgb = dataset.load_image(*v);
         t.mask = dataset.load_mask(*v);
         t.sky = dataset.load_sky_mask(*v);
+        t.coverage = dataset.load_coverage(*v);
         out.push_back(std::move(t));
     }
     return out;
@@ -262,8 +263,11 @@ void Trainer::prepare_view_masks() {
         }
         if (object_masks) {
             // The outside of the object is empty space: no photometric loss there (the mask), alpha -> 0.
+            // Pixels the undistorted photo does not cover are unknown, not empty.
             Image outside = view.mask;
-            for (float& x : outside.pixels) x = 1.0f - x;
+            for (std::size_t p = 0; p < pixels; ++p)
+                outside.pixels[p] = (1.0f - outside.pixels[p]) *
+                                    (view.coverage.pixels.empty() ? 1.0f : view.coverage.pixels[p]);
             m.empty = eroded_mask(outside, c.sky_mask_erosion);
         } else {
             m.empty = m.sky;

@@ -35,6 +35,8 @@ struct TrainView {
     Image rgb;
     Image mask;
     Image sky;
+    // Where the photo holds the pixel's ray after undistortion (Dataset::load_coverage); empty = everywhere.
+    Image coverage;
 };
 
 // The training photos of a dataset (its train split), in dataset (name) order; the position in this list

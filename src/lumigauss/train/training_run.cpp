@@ -111,6 +111,7 @@ TrainingRun::TrainingRun(const TrainingRunRequest& request) : paths_(run_paths(r
         held_out_photos_ = data.views.size() - data.split(Split::Train).size();
         far_points_dropped_ = data.far_points_dropped;
         cameras_fitted_ = data.cameras_fitted_to_photos;
+        undistorted_ = data.undistorted_views();
         far_point_limit_ = data.far_point_limit;
         trainer_ = std::make_unique<Trainer>(load_train_views(data), data.point_xyz, data.point_rgb, config);
         std::filesystem::create_directories(request.out);  // only once the input is known to be good

@@ -59,6 +59,9 @@ class TrainingRun {
     // SfM points the dataset dropped for lying absurdly far from the cameras, and beyond what distance.
     std::size_t far_points_dropped() const { return far_points_dropped_; }
     std::size_t cameras_fitted_to_photos() const { return cameras_fitted_; }  // Dataset's, of a new run
+    std::size_t undistorted_photos() const {
+        return undistorted_;
+    }  // Dataset::undistorted_views, of a new run
     double far_point_limit() const { return far_point_limit_; }
     // The message of the non-finite value that ended run() (TrainingOutcome::NonFinite).
     const std::string& failure() const { return failure_; }
@@ -72,7 +75,7 @@ class TrainingRun {
     bool resumed_ = false;
     std::size_t sfm_points_ = 0, held_out_photos_ = 0;
     std::string auto_note_;
-    std::size_t far_points_dropped_ = 0, cameras_fitted_ = 0;
+    std::size_t far_points_dropped_ = 0, cameras_fitted_ = 0, undistorted_ = 0;
     double far_point_limit_ = 0;
     std::string failure_;
     double elapsed_ = 0;
