@@ -26,7 +26,7 @@ namespace lumigauss::cli {
 namespace {
 
 struct ExportOptions {
-    std::string source, ply, format, out, light, up = "+z", shading = "shadowed";
+    std::string source, ply, format, out, light, up = "auto", shading = "shadowed";
     double rotate_degrees = 0, exposure = 1.0, hdr_threshold = 0.99, hdr_scale = 1.0;
     bool match_exposure = false;
     int width = 512;
@@ -58,10 +58,11 @@ void run_export(const ExportOptions& o) {
     if (baked && o.light.empty()) throw Error("--format " + o.format + " bakes colours: give --light");
     if (!baked && !o.light.empty())
         throw Error("--light is for the baked formats (ply-3dgs, splat), not " + o.format);
-    const Vec3d up = parse_up_axis(o.up);
     const BakeShading shading = parse_bake_shading(o.shading);
 
     const TrainedRun run = load_run_or_ply(source);
+    // auto: the up of the training photos the run recorded; +z for a bare PLY.
+    const Vec3d up = o.up == "auto" ? run.photos_up.value_or(Vec3d{0, 0, 1}) : parse_up_axis(o.up);
     if (baked) {
         PanoramaOptions popt;
         popt.frame = panorama_frame_for_up(up);
@@ -118,7 +119,10 @@ void register_export(CLI::App& app) {
     cmd->add_option("--shading", o->shading,
                     "baked colour: shadowed (the full model, positive transfer set) or unshadowed (+normal)")
         ->capture_default_str();
-    cmd->add_option("--up", o->up, "world up axis: +z (default), -y, +y, +x, -x, -z")->capture_default_str();
+    cmd->add_option("--up", o->up,
+                    "world up (panorama lights, --rotate, the bundle's up): +z, -y, +y, +x, -x, -z, a vector "
+                    "X,Y,Z, or auto (the run's training photos; +z for a bare PLY)")
+        ->capture_default_str();
     cmd->add_option("--rotate", o->rotate_degrees, "turn the light by DEG about the up axis")
         ->capture_default_str();
     cmd->add_option("--exposure", o->exposure, "multiply the light SH by E")->capture_default_str();

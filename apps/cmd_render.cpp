@@ -198,9 +198,11 @@ void register_render(CLI::App& app) {
     cmd->add_option("--frames", j.orbit_frames, "cameras of --cameras orbit")
         ->capture_default_str()
         ->group(run_group);
-    cmd->add_option("--up", j.up,
-                    "world up axis for --rotate/--spin, panoramas and orbits: +z (synthetic scenes, "
-                    "Blender), -y (COLMAP/NeRF-OSR y-down), +y, +x, -x, -z, or auto (from the cameras)")
+    cmd->add_option(
+           "--up", j.up,
+           "world up for --rotate/--spin, panoramas and orbits: auto (the up of the scene's or the "
+           "JSON's cameras, not rounded to an axis), +z (synthetic scenes, Blender), -y (COLMAP y-down), "
+           "+y, +x, -x, -z, or a vector X,Y,Z")
         ->capture_default_str()
         ->group(run_group);
     cmd->add_option("--rotate", j.rotate_degrees,

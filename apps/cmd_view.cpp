@@ -26,7 +26,7 @@ namespace lumigauss::cli {
 namespace {
 
 struct ViewOptions {
-    std::string source, scene, camera_json, up = "+z", bench_report;
+    std::string source, scene, camera_json, up = "auto", bench_report;
     std::vector<std::string> lights;
     int port = 8080;
 };
@@ -88,17 +88,18 @@ std::vector<Camera> known_cameras(const ViewOptions& o) {
     return cams;
 }
 
-Vec3d resolve_up(const ViewOptions& o, const std::vector<Camera>& cams) {
+// --up, or for "auto" the up of the known cameras, else of the training photos the run recorded, else +z
+// (a bare PLY).
+Vec3d resolve_up(const ViewOptions& o, const std::vector<Camera>& cams, const TrainedRun& run) {
     if (o.up != "auto") return parse_up_axis(o.up);
-    if (cams.empty())
-        throw Error("view: --up auto estimates the up axis from cameras: give --scene or --camera");
-    return estimate_up_axis(cams);
+    if (!cams.empty()) return estimate_up_axis(cams);
+    return run.photos_up.value_or(Vec3d{0, 0, 1});
 }
 
 void run_view(const ViewOptions& o) {
     const TrainedRun run = load_run_or_ply(o.source);
     const std::vector<Camera> cams = known_cameras(o);
-    const Vec3d up = resolve_up(o, cams);
+    const Vec3d up = resolve_up(o, cams, run);
     PanoramaOptions popt;
     popt.frame = panorama_frame_for_up(up);
     std::vector<ResolvedLight> lights;
@@ -145,9 +146,11 @@ void register_view(CLI::App& app) {
     cmd->add_option("--light", o->lights,
                     "extra lighting(s) offered first: a training photo's name, a .txt SH file (9 rows R G B) "
                     "or a panorama, as for `render --light` (repeatable)");
-    cmd->add_option("--up", o->up,
-                    "world up axis for orbiting and turning the environment: +z (default), -y, +y, +x, -x, "
-                    "-z, or auto (from --scene/--camera)")
+    cmd->add_option(
+           "--up", o->up,
+           "world up for orbiting and turning the environment: +z, -y, +y, +x, -x, -z, a vector "
+           "X,Y,Z, or auto (the cameras' up: --camera, the scene, the run's training photos; +z for a "
+           "bare PLY)")
         ->capture_default_str();
     cmd->add_option("--scene", o->scene,
                     "scene folder (COLMAP or NeRF-OSR): its first training view is the initial camera "

@@ -177,7 +177,10 @@ TEST(CliView, InitialCameraAndUpAxisFromACameraJson) {
     end_child(pid, false);
     ASSERT_TRUE(port) << read_text(tmp / "log.txt");
     const nlohmann::json j = nlohmann::json::parse(scene.second);
-    EXPECT_EQ(j["up_name"], "-y");
+    // The camera's own up (its -y), not the axis nearest to it (-y).
+    const Vec3d camera_up = -1.0 * cam.rotation.row(1);
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(j["up"][i].get<double>(), camera_up[i], 1e-9) << i;
+    EXPECT_EQ(j["up_name"], up_axis_name(camera_up));
     EXPECT_EQ(j["camera"]["fx"].get<double>(), cam.fx);
     EXPECT_EQ(j["camera"]["t"][1].get<double>(), cam.translation.y);
 }
@@ -210,9 +213,9 @@ TEST(CliView, BadSourceOrUpAxisIsAnErrorNamingIt) {
     EXPECT_NE(missing.output.find("nope"), std::string::npos) << missing.output;
     write_model_and_light(tmp, testing::test_camera(), 10);
     const auto up =
-        testing::run_lumigauss("view " + testing::shell_quoted(tmp / "model.ply") + " --up auto", tmp);
+        testing::run_lumigauss("view " + testing::shell_quoted(tmp / "model.ply") + " --up sideways", tmp);
     EXPECT_NE(up.exit_code, 0);
-    EXPECT_NE(up.output.find("--scene or --camera"), std::string::npos) << up.output;
+    EXPECT_NE(up.output.find("up axis 'sideways'"), std::string::npos) << up.output;
 }
 
 // ---------------------------------------------------------------------------------------------------------

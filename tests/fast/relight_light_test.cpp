@@ -211,6 +211,13 @@ TEST(RelightLight, UpAxisParsing) {
     EXPECT_THROW(parse_up_axis(""), Error);
     EXPECT_THROW(parse_up_axis("+"), Error);
     EXPECT_EQ(up_axis_name(parse_up_axis("-y")), "-y");
+    // Any vector, normalized; its name reads back.
+    const Vec3d v = parse_up_axis("0.1, -2,0.2");
+    EXPECT_NEAR(length(v - normalize(Vec3d{0.1, -2, 0.2})), 0.0, 1e-15);
+    EXPECT_NEAR(length(parse_up_axis(up_axis_name(v)) - v), 0.0, 1e-6);
+    EXPECT_EQ(up_axis_name(parse_up_axis("0,0,3")), "+z");
+    for (const char* bad : {"0,0,0", "1,2", "1,2,3,4", "1,,2", "1,nan,2", "1,2,x", "auto"})
+        EXPECT_THROW(parse_up_axis(bad), Error) << bad;
 }
 
 TEST(RelightLight, PanoramaFrameLooksUpAndIsARotation) {
@@ -224,6 +231,17 @@ TEST(RelightLight, PanoramaFrameLooksUpAndIsARotation) {
             for (int c = 0; c < 3; ++c) EXPECT_NEAR(i(r, c), r == c ? 1.0 : 0.0, 1e-12) << name;
         EXPECT_NEAR(dot(cross(f.col(0), f.col(1)), f.col(2)), 1.0, 1e-12) << name;
     }
+    // Any other up: a rotation whose top row is up, continuous with the nearest axis's frame.
+    for (const Vec3d up :
+         {normalize(Vec3d{0.05, -1, 0.1}), normalize(Vec3d{1, 1, 1.2}), normalize(Vec3d{-0.3, 0.2, -1})}) {
+        const Mat3d f = panorama_frame_for_up(up);
+        EXPECT_NEAR(length(f * Vec3d{0, 0, 1} - up), 0.0, 1e-12);
+        EXPECT_NEAR(dot(cross(f.col(0), f.col(1)), f.col(2)), 1.0, 1e-12);
+        EXPECT_NEAR(length(f.col(0)), 1.0, 1e-12);
+        EXPECT_NEAR(dot(f.col(0), f.col(2)), 0.0, 1e-12);
+    }
+    const Mat3d near_ydown = panorama_frame_for_up(normalize(Vec3d{1e-4, -1, 0}));
+    EXPECT_NEAR(length(near_ydown.col(1) - Vec3d{0, 0, 1}), 0.0, 1e-3);
     // -y is envmap.h's documented y-down frame.
     const Mat3d ydown = panorama_frame_for_up(Vec3d{0, -1, 0});
     EXPECT_NEAR(length(ydown.col(0) - Vec3d{1, 0, 0}), 0.0, 1e-12);
@@ -240,6 +258,11 @@ TEST(RelightLight, EstimatedUpIsTheCamerasUp) {
         cams[i].rotation = {{right, normalize(cross(f, right)), normalize(f)}};
     }
     EXPECT_EQ(up_axis_name(estimate_up_axis(cams)), "+z");
+    // The same cameras in a world tilted by 20 deg: the up tilts with them (an axis nearest to it would not).
+    const Mat3d tilt = rotation_about_axis(Vec3d{1, 0, 0}, 20 * std::numbers::pi / 180);
+    std::vector<Camera> tilted = cams;
+    for (Camera& c : tilted) c.rotation = c.rotation * transpose(tilt);
+    EXPECT_NEAR(length(estimate_up_axis(tilted) - tilt * Vec3d{0, 0, 1}), 0.0, 1e-9);
     // COLMAP-like cameras with the identity rotation: y down = world +y, so up = -y.
     std::vector<Camera> colmap(2);
     EXPECT_EQ(up_axis_name(estimate_up_axis(colmap)), "-y");

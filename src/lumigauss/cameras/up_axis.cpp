@@ -2,13 +2,59 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <numbers>
+#include <optional>
 
 #include "lumigauss/math/symmetric_eigen.h"
 #include "lumigauss/shading/sh_rotation.h"
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {
+
+namespace {
+
+// "X,Y,Z" with finite numbers (spaces allowed), or none.
+std::optional<Vec3d> parse_vector(const std::string& text) {
+    Vec3d v{};
+    std::size_t at = 0;
+    for (int i = 0; i < 3; ++i) {
+        const std::size_t end = i < 2 ? text.find(',', at) : text.size();
+        if (end == std::string::npos) return std::nullopt;
+        const std::string part = text.substr(at, end - at);
+        char* stop = nullptr;
+        v[i] = std::strtod(part.c_str(), &stop);
+        while (stop && *stop == ' ') ++stop;
+        if (part.find_first_not_of(' ') == std::string::npos || !stop || *stop != '\0' ||
+            !std::isfinite(v[i]))
+            return std::nullopt;
+        at = end + 1;
+    }
+    return v;
+}
+
+// The coordinate axis nearest to `v` (by the largest component), signed.
+Vec3d nearest_axis(Vec3d v) {
+    int best = 0;
+    for (int a = 1; a < 3; ++a)
+        if (std::abs(v[a]) > std::abs(v[best])) best = a;
+    Vec3d axis{};
+    axis[best] = v[best] >= 0 ? 1 : -1;
+    return axis;
+}
+
+Mat3d axis_panorama_frame(Vec3d axis) {
+    const double half_pi = std::numbers::pi / 2;
+    if (axis.z > 0.5) return Mat3d::identity();
+    if (axis.z < -0.5) return rotation_about_axis(Vec3d{1, 0, 0}, std::numbers::pi);
+    if (axis.y < -0.5) return rotation_about_axis(Vec3d{1, 0, 0}, half_pi);
+    if (axis.y > 0.5) return rotation_about_axis(Vec3d{1, 0, 0}, -half_pi);
+    if (axis.x > 0.5) return rotation_about_axis(Vec3d{0, 1, 0}, half_pi);
+    return rotation_about_axis(Vec3d{0, 1, 0}, -half_pi);
+}
+
+}  // namespace
 
 Vec3d parse_up_axis(const std::string& text) {
     std::string s;
@@ -21,7 +67,10 @@ Vec3d parse_up_axis(const std::string& text) {
     if (s == "x") return {sign, 0, 0};
     if (s == "y") return {0, sign, 0};
     if (s == "z") return {0, 0, sign};
-    throw Error("up axis '" + text + "': expected one of +x, -x, +y, -y, +z, -z (or auto)");
+    const std::optional<Vec3d> v = parse_vector(text);
+    if (!v) throw Error("up axis '" + text + "': expected one of +x, -x, +y, -y, +z, -z or a vector X,Y,Z");
+    if (!(length(*v) > 0)) throw Error("up axis '" + text + "': the vector has no length");
+    return normalize(*v);
 }
 
 Vec3d camera_up_direction(const std::vector<Mat3d>& world_to_camera) {
@@ -46,34 +95,34 @@ Vec3d camera_up_direction(const std::vector<Mat3d>& world_to_camera) {
 
 Vec3d estimate_up_axis(const std::vector<Camera>& cameras) {
     if (cameras.empty()) throw Error("up axis auto: no camera to estimate it from");
-    Vec3d mean{};
-    for (const Camera& c : cameras) mean += -c.rotation.row(1);
-    int best = 0;
-    for (int a = 1; a < 3; ++a)
-        if (std::abs(mean[a]) > std::abs(mean[best])) best = a;
-    if (!(std::abs(mean[best]) > 1e-9 * double(cameras.size())))
+    std::vector<Mat3d> rotations;
+    for (const Camera& c : cameras) rotations.push_back(c.rotation);
+    const Vec3d up = camera_up_direction(rotations);
+    if (!(length(up) > 0))
         throw Error("up axis auto: the cameras' up vectors cancel out; give --up explicitly");
-    Vec3d up{};
-    up[best] = mean[best] > 0 ? 1 : -1;
     return up;
 }
 
 std::string up_axis_name(Vec3d up) {
-    const char* names = "xyz";
-    for (int a = 0; a < 3; ++a)
-        if (std::abs(up[a]) > 0.5) return std::string(up[a] > 0 ? "+" : "-") + names[a];
-    return "?";
+    const Vec3d axis = nearest_axis(up);
+    if (length(up - axis) < 1e-9) {
+        const char* names = "xyz";
+        for (int a = 0; a < 3; ++a)
+            if (axis[a] != 0) return std::string(axis[a] > 0 ? "+" : "-") + names[a];
+    }
+    char text[96];
+    std::snprintf(text, sizeof text, "%.6f,%.6f,%.6f", up.x, up.y, up.z);
+    return text;
 }
 
 Mat3d panorama_frame_for_up(Vec3d up) {
-    const double half_pi = std::numbers::pi / 2;
-    if (up.z > 0.5) return Mat3d::identity();
-    if (up.z < -0.5) return rotation_about_axis(Vec3d{1, 0, 0}, std::numbers::pi);
-    if (up.y < -0.5) return rotation_about_axis(Vec3d{1, 0, 0}, half_pi);
-    if (up.y > 0.5) return rotation_about_axis(Vec3d{1, 0, 0}, -half_pi);
-    if (up.x > 0.5) return rotation_about_axis(Vec3d{0, 1, 0}, half_pi);
-    if (up.x < -0.5) return rotation_about_axis(Vec3d{0, 1, 0}, -half_pi);
-    throw Error("panorama frame: the up vector is not a coordinate axis");
+    if (!(length(up) > 0.5)) throw Error("panorama frame: the up vector has no length");
+    up = normalize(up);
+    const Vec3d axis = nearest_axis(up);
+    const Vec3d turn = cross(axis, up);  // |turn| = sin of the angle; the nearest axis is < 55 deg away
+    const Mat3d frame = axis_panorama_frame(axis);
+    if (!(length(turn) > 1e-12)) return frame;
+    return rotation_about_axis(normalize(turn), std::atan2(length(turn), dot(axis, up))) * frame;
 }
 
 ShCoeffs<double> rotate_about_up(const ShCoeffs<double>& sh, Vec3d up, double degrees) {

@@ -1,8 +1,9 @@
 #pragma once
-// The world's up axis for relighting: turning the environment (--rotate, --spin), placing a panorama (its
-// top row is up) and orbiting the scene all happen about it. Written as a signed coordinate axis: "+z" (the
-// default: the synthetic scenes and Blender), "-y" (COLMAP/NeRF-OSR reconstructions whose cameras have y
-// down), "+y", "x", ...; "auto" picks the signed axis nearest to the mean up vector of the cameras.
+// The world's up for relighting: turning the environment (--rotate, --spin), placing a panorama (its top
+// row is up) and orbiting the scene all happen about it. Written as a signed coordinate axis: "+z" (the
+// synthetic scenes and Blender), "-y" (COLMAP/NeRF-OSR reconstructions whose cameras have y down), "+y",
+// "x", ..., as any vector "X,Y,Z", or "auto": the up of the photos' cameras (camera_up_direction), which is
+// not rounded to an axis (a real reconstruction's up is rarely one).
 #include <string>
 #include <vector>
 
@@ -12,7 +13,8 @@
 
 namespace lumigauss {
 
-// "x", "+x", "-x", ... "-z" (case-insensitive) -> the unit vector. Throws Error on anything else.
+// "x", "+x", "-x", ... "-z" (case-insensitive), or three comma-separated numbers -> the unit vector. Throws
+// Error on anything else (a zero or non-finite vector included).
 Vec3d parse_up_axis(const std::string& text);
 
 // The world's up direction from world-to-camera rotations (not rounded to an axis), for the horizon: photos
@@ -23,16 +25,18 @@ Vec3d parse_up_axis(const std::string& text);
 // without its part along them. Zero when there is no rotation or the mean -y vanishes.
 Vec3d camera_up_direction(const std::vector<Mat3d>& world_to_camera);
 
-// The signed coordinate axis closest to the mean world up vector (-(row 1 of R), the camera's -y) of the
-// cameras. Throws Error when there is no camera or the mean vanishes.
+// The cameras' up (camera_up_direction of their rotations). Throws Error when there is no camera or their
+// rotations fix no up (the mean -y vanishes).
 Vec3d estimate_up_axis(const std::vector<Camera>& cameras);
 
-// "+z", "-y", ...: the axis a unit coordinate vector names (for messages).
+// "+z", "-y", ... for a coordinate axis, else "X,Y,Z" (6 decimals), which parse_up_axis reads back.
 std::string up_axis_name(Vec3d up);
 
-// The panorama frame (shading/envmap.h) whose top row looks along `up`: a rotation with third column `up`.
-// +z: identity; -y: rotation about +X by +90 deg (the y-down frame of envmap.h); +y: about +X by -90 deg;
-// +x: about +Y by +90 deg; -x: about +Y by -90 deg; -z: about +X by 180 deg. `up` must be a coordinate axis.
+// The panorama frame (shading/envmap.h) whose top row looks along the unit vector `up`: a rotation with third
+// column `up`. +z: identity; -y: rotation about +X by +90 deg (the y-down frame of envmap.h); +y: about +X by
+// -90 deg; +x: about +Y by +90 deg; -x: about +Y by -90 deg; -z: about +X by 180 deg. Any other up: the frame
+// of the nearest of these axes, tilted by the smallest rotation that takes that axis to `up` (so the
+// panorama's centre column stays where the axis frame puts it, tilted with the world).
 Mat3d panorama_frame_for_up(Vec3d up);
 
 // The lighting turned by `degrees` about `up`, right-handed (seen from above, counter-clockwise: a sun at

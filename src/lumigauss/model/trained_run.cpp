@@ -4,6 +4,7 @@
 #include <cctype>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/io/text_file.h"
@@ -15,19 +16,11 @@ namespace lumigauss {
 
 namespace {
 
-// The horizon the run was trained with (Trainer::sky_horizon): the config's angles about the mean up of
-// the training photos in scene.json. None when either is missing.
-SkyHorizon recorded_sky_horizon(const nlohmann::json& config, const std::string& dir) {
-    SkyHorizon horizon;
-    const auto number = [&](const char* key) {
-        return config.is_object() && config.contains(key) && config[key].is_number()
-                   ? config[key].get<double>()
-                   : 0.0;
-    };
-    const double start = number("sky_horizon_start"), fade = number("sky_horizon_fade");
-    if (!(fade > 0)) return horizon;
+// The up of the training photos that scene.json records (camera_up_direction); none without the record or
+// when their rotations do not fix one.
+std::optional<Vec3d> recorded_photos_up(const std::string& dir) {
     const std::optional<SceneRecord> scene = load_scene_record(run_paths(dir).scene);
-    if (!scene) return horizon;
+    if (!scene) return std::nullopt;
     std::vector<Mat3d> rotations;
     for (const RecordedPhoto& p : scene->photos) {
         if (p.split != "train") continue;
@@ -37,8 +30,22 @@ SkyHorizon recorded_sky_horizon(const nlohmann::json& config, const std::string&
         rotations.push_back(r);
     }
     const Vec3d up = camera_up_direction(rotations);
-    if (!(length(up) > 0)) return horizon;
-    horizon.up = up.cast<float>();
+    if (!(length(up) > 0)) return std::nullopt;
+    return up;
+}
+
+// The horizon the run was trained with (Trainer::sky_horizon): the config's angles about the up of the
+// training photos. None when either is missing.
+SkyHorizon recorded_sky_horizon(const nlohmann::json& config, const std::optional<Vec3d>& up) {
+    SkyHorizon horizon;
+    const auto number = [&](const char* key) {
+        return config.is_object() && config.contains(key) && config[key].is_number()
+                   ? config[key].get<double>()
+                   : 0.0;
+    };
+    const double start = number("sky_horizon_start"), fade = number("sky_horizon_fade");
+    if (!(fade > 0) || !up) return horizon;
+    horizon.up = up->cast<float>();
     horizon.start_degrees = float(start);
     horizon.fade_degrees = float(fade);
     return horizon;
@@ -85,6 +92,7 @@ TrainedRun load_trained_run(const std::string& dir) {
                                             run.paths.appearance + " lists " +
                                             std::to_string(run.image_names.size()));
     }
+    run.photos_up = recorded_photos_up(dir);
     if (fs::exists(run.paths.config)) {
         const nlohmann::json c = nlohmann::json::parse(read_text_file(run.paths.config), nullptr, false);
         if (c.is_discarded()) fail_in_file(run.paths.config, "not valid JSON");
@@ -92,7 +100,7 @@ TrainedRun load_trained_run(const std::string& dir) {
             run.downscale = c["downscale"].get<int>();
         if (c.is_object() && c.contains("sky_background") && c["sky_background"].is_boolean())
             run.sky_background = c["sky_background"].get<bool>();
-        run.sky_horizon = recorded_sky_horizon(c, dir);
+        run.sky_horizon = recorded_sky_horizon(c, run.photos_up);
     }
     return run;
 }

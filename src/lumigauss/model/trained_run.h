@@ -2,6 +2,7 @@
 // A finished training run, loaded for rendering and evaluation: the surfels (model.ply), the lighting MLP
 // (lighting.lgmlp) and the photo names in embedding order (appearance.json), plus the training resolution
 // from config.json when present. The run folder layout is run_files.h's.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,8 +24,11 @@ struct TrainedRun {
     int downscale = 0;                     // config.json "downscale"; 0 if unknown
     bool sky_background = false;           // config.json "sky_background": trained with the sky drawn behind
     SkyResiduals sky_residuals;            // sky.lgsky when present (per-photo sky residuals)
-    // Where that sky ends below the horizon: config.json sky_horizon_start/fade, about the mean up of the
-    // training cameras that scene.json records (no horizon without them, as the run was trained then).
+    // The world's up as the training photos that scene.json records give it (camera_up_direction); none
+    // without the record (a bare PLY, a run of an older version).
+    std::optional<Vec3d> photos_up;
+    // Where that sky ends below the horizon: config.json sky_horizon_start/fade, about photos_up (no horizon
+    // without it, as the run was trained then).
     SkyHorizon sky_horizon;
 
     // Embedding index of the training photo called exactly `name`, or -1.

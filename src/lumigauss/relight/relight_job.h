@@ -28,7 +28,7 @@ struct RelightJob {
     std::vector<std::string> views;  // keep only these cameras (image name, its stem, or JSON name)
     int downscale = 0;               // 0: the run's training resolution for scene cameras, 1 for JSON
     std::string light;               // see light_source.h
-    std::string up = "+z";           // up_axis.h, or "auto"
+    std::string up = "auto";         // up_axis.h, or "auto" (the cameras' up)
     double rotate_degrees = 0;
     int spin = 0;           // > 0: that many frames turning the environment through 360 deg
     int orbit_frames = 60;  // cameras of --cameras orbit
