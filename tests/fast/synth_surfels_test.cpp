@@ -19,6 +19,7 @@
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/synth/camera_paths.h"
 #include "lumigauss/synth/world.h"
+#include "support/sanitizers.h"
 #include "synth_test_util.h"
 
 namespace lumigauss {
@@ -223,6 +224,7 @@ TEST(SynthSurfels, FileIsASurfelModelOfTheStaticSurfaces) {
 // alpha >= 0.94 on all of them. At the native resolution (no supersampling) face interiors give
 // 27.2 dB and clear pixels 19.5 dB (thin features widened by the screen filter).
 TEST(SynthSurfels, RenderLikeTheGroundTruthAlbedo) {
+    LUMIGAUSS_OUTCOME_ONLY_IN_RELEASE();  // the rasterizer under the sanitizers: the Raster* tests
     const Comparison cmp(dataset());
     const auto e = cmp.errors();
     ASSERT_GT(e.interior.pixels, 3000u);
@@ -240,6 +242,7 @@ TEST(SynthSurfels, RenderLikeTheGroundTruthAlbedo) {
 // screen filter's widening of foreground edges alone moves the vertices by 0.4 to 0.7 px, so this check
 // needs the supersampling.
 TEST(SynthSurfels, RendersAreRegisteredWithTheGroundTruthToASubpixel) {
+    LUMIGAUSS_OUTCOME_ONLY_IN_RELEASE();
     const Comparison cmp(dataset());
     const double h = double(kMargin) / kSupersample, at_zero = cmp.errors().clear.mse;
     for (int axis = 0; axis < 2; ++axis) {
