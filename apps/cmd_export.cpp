@@ -31,6 +31,7 @@ struct ExportOptions {
     bool match_exposure = false;
     int width = 512;
     int threads = 0;
+    bool quiet = false;
 };
 
 bool baked_format(const std::string& f) {
@@ -78,21 +79,24 @@ void run_export(const ExportOptions& o) {
             write_3dgs_ply(o.out, run.model, colours);
         else
             write_splat_file(o.out, splat_records(run.model, colours));
-        std::printf("export: %zu surfels baked (%s, %s '%s') to %s (%s)\n", run.model.size(),
-                    o.shading.c_str(), light_kind_name(light.kind), light.source.c_str(), o.out.c_str(),
-                    o.format.c_str());
+        if (!o.quiet)
+            std::printf("export: %zu surfels baked (%s, %s '%s') to %s (%s)\n", run.model.size(),
+                        o.shading.c_str(), light_kind_name(light.kind), light.source.c_str(), o.out.c_str(),
+                        o.format.c_str());
         return;
     }
     if (o.format == "ply-relightable") {
         make_parent(o.out);
         const std::string sidecar = write_relightable_bundle(o.out, run, up);
-        std::printf("export: %zu surfels to %s, %zu environment(s) to %s\n", run.model.size(), o.out.c_str(),
-                    run.image_names.size(), sidecar.c_str());
+        if (!o.quiet)
+            std::printf("export: %zu surfels to %s, %zu environment(s) to %s\n", run.model.size(),
+                        o.out.c_str(), run.image_names.size(), sidecar.c_str());
         return;
     }
     const auto files = write_environment_files(o.out, learned_environments(run), up, o.width);
-    std::printf("export: %zu environment(s) to %s (%zu files)\n", run.image_names.size(), o.out.c_str(),
-                files.size());
+    if (!o.quiet)
+        std::printf("export: %zu environment(s) to %s (%zu files)\n", run.image_names.size(), o.out.c_str(),
+                    files.size());
 }
 
 }  // namespace
@@ -123,6 +127,7 @@ void register_export(CLI::App& app) {
                     "world up (panorama lights, --rotate, the bundle's up): +z, -y, +y, +x, -x, -z, a vector "
                     "X,Y,Z, or auto (the run's training photos; +z for a bare PLY)")
         ->capture_default_str();
+    cmd->add_flag("-q,--quiet", o->quiet, "print nothing (errors still go to stderr)");
     cmd->add_option("--rotate", o->rotate_degrees, "turn the light by DEG about the up axis")
         ->capture_default_str();
     cmd->add_option("--exposure", o->exposure, "multiply the light SH by E")->capture_default_str();

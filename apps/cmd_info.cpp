@@ -1,4 +1,4 @@
-// `lumigauss info <scene> [-r N]`: what load_dataset sees in a scene folder, before any training.
+// `lumigauss info <scene> [-r N] [-q]`: what load_dataset sees in a scene folder, before any training.
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -16,6 +16,7 @@ struct InfoOptions {
     std::string scene;
     int downscale = 1;
     std::string masks = "transient";
+    bool quiet = false;
 };
 
 // "128x96 (20), 64x48 (3)": distinct values with how many views have each.
@@ -87,6 +88,12 @@ void run_info(const InfoOptions& o) {
     DatasetOptions options;
     options.downscale = o.downscale;
     const Dataset d = load_dataset(o.scene, options);
+    if (o.quiet) {  // one line, for scripts and logs
+        std::printf("info: %s: %s, %zu views (train %zu, test %zu), %zu SfM points\n", d.root.c_str(),
+                    d.format.c_str(), d.views.size(), d.split(Split::Train).size(),
+                    d.split(Split::Test).size(), d.point_xyz.size());
+        return;
+    }
     std::printf("scene:         %s\nformat:        %s\n", d.root.c_str(), d.format.c_str());
     print_views(d, o.masks);
     print_extent(d);
@@ -105,6 +112,7 @@ void register_info(CLI::App& app) {
         ->check(CLI::IsMember({1, 2, 4, 8}));
     cmd->add_option("--masks", options->masks, "How train takes the masks: transient (default) or object")
         ->check(CLI::IsMember({"transient", "object"}));
+    cmd->add_flag("-q,--quiet", options->quiet, "print one summary line");
     cmd->callback([options] { run_info(*options); });
 }
 

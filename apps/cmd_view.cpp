@@ -27,6 +27,7 @@ namespace {
 
 struct ViewOptions {
     std::string source, scene, camera_json, up = "auto", bench_report;
+    bool quiet = false;
     std::vector<std::string> lights;
     int port = 8080;
 };
@@ -122,11 +123,13 @@ void run_view(const ViewOptions& o) {
     view::HttpServer server(server_options, [&site](const view::HttpRequest& r) { return site.handle(r); });
     server_ptr = &server;
     StopSignals signals(server);
-    std::printf("view: %zu surfels, %zu lights, up %s\nview: open http://127.0.0.1:%d/ (Ctrl-C to stop)\n",
-                run.model.size(), scene.lights.size(), up_axis_name(up).c_str(), server.port());
+    if (!o.quiet)
+        std::printf("view: %zu surfels, %zu lights, up %s\n", run.model.size(), scene.lights.size(),
+                    up_axis_name(up).c_str());
+    std::printf("view: open http://127.0.0.1:%d/ (Ctrl-C to stop)\n", server.port());
     std::fflush(stdout);
     server.run();
-    std::printf("view: stopped\n");
+    if (!o.quiet) std::printf("view: stopped\n");
 }
 
 }  // namespace
@@ -152,6 +155,7 @@ void register_view(CLI::App& app) {
            "X,Y,Z, or auto (the cameras' up: --camera, the scene, the run's training photos; +z for a "
            "bare PLY)")
         ->capture_default_str();
+    cmd->add_flag("-q,--quiet", o->quiet, "print only the address to open");
     cmd->add_option("--scene", o->scene,
                     "scene folder (COLMAP or NeRF-OSR): its first training view is the initial camera "
                     "(default: the scene the run was trained on, RUN/scene.json, if it is still there)");

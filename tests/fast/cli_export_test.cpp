@@ -6,8 +6,10 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <numbers>
 #include <string>
 
+#include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/export/relightable_bundle.h"
 #include "lumigauss/model/relightable_ply.h"
 #include "lumigauss/model/splat_ply.h"
@@ -97,13 +99,17 @@ TEST(CliExport, EveryFormatAndImportFromBarePly) {
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(fs::file_size(tmp / "m.splat"), 32 * surfels);
 
-    // ply-relightable + sidecar.
+    // ply-relightable + sidecar; -q prints nothing. The sidecar's up is the training photos' (the synthetic
+    // scene is z-up), not the +z default a bare PLY gets.
     r = run_lumigauss(
-        "export " + shell_quoted(t.run) + " --format ply-relightable -o " + shell_quoted(tmp / "rel.ply"),
+        "export -q " + shell_quoted(t.run) + " --format ply-relightable -o " + shell_quoted(tmp / "rel.ply"),
         tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(r.output, "");
     EXPECT_EQ(load_relightable_ply(tmp / "rel.ply").size(), surfels);
-    EXPECT_EQ(read_environment_sidecar(tmp / "rel.environments.json").environments.size(), photos.size());
+    const EnvironmentSidecar sidecar = read_environment_sidecar(tmp / "rel.environments.json");
+    EXPECT_EQ(sidecar.environments.size(), photos.size());
+    EXPECT_GT(parse_up_axis(sidecar.up).z, std::cos(2 * std::numbers::pi / 180)) << sidecar.up;
 }
 
 TEST(CliExport, BadInputNamesTheProblem) {

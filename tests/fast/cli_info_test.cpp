@@ -63,6 +63,10 @@ TEST(CliInfo, SmallSceneExtent) {
     EXPECT_TRUE(contains(r.output, "mean (1, 0, -5), extent 1.1 ")) << r.output;
     EXPECT_TRUE(contains(r.output, "sky masks:     0 of 3 views (the sky is then found")) << r.output;
     EXPECT_TRUE(contains(r.output, "min (-1, 0, 0), max (1, 2, 3)")) << r.output;
+    const CommandResult quiet = run_lumigauss("info -q '" + (tmp / "scene") + "'", tmp);
+    ASSERT_EQ(quiet.exit_code, 0) << quiet.output;
+    EXPECT_EQ(quiet.output,
+              "info: " + (tmp / "scene") + ": colmap-text, 3 views (train 2, test 1), 3 SfM points\n");
 }
 
 TEST(CliInfo, BrokenSceneFailsNamingTheFile) {

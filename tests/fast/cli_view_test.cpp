@@ -169,13 +169,14 @@ TEST(CliView, InitialCameraAndUpAxisFromACameraJson) {
     write_model_and_light(tmp, cam, 20);
     write_camera_json(tmp / "cams.json", {{"first", cam}});
     const pid_t pid = spawn({LUMIGAUSS_BINARY, "view", tmp / "model.ply", "--port", "0", "--camera",
-                             tmp / "cams.json", "--up", "auto"},
+                             tmp / "cams.json", "--up", "auto", "-q"},
                             tmp / "log.txt", false);
     ASSERT_GT(pid, 0);
     const std::optional<int> port = wait_for_port(tmp / "log.txt", 20);
     const auto scene = port ? http_get(*port, "/scene.json") : std::pair<int, std::string>{};
     end_child(pid, false);
     ASSERT_TRUE(port) << read_text(tmp / "log.txt");
+    EXPECT_EQ(read_text(tmp / "log.txt").find("surfels"), std::string::npos) << "-q prints only the address";
     const nlohmann::json j = nlohmann::json::parse(scene.second);
     // The camera's own up (its -y), not the axis nearest to it (-y).
     const Vec3d camera_up = -1.0 * cam.rotation.row(1);
