@@ -1,8 +1,8 @@
 // `lumigauss env`: equirectangular panorama <-> degree-2 environment SH, in the world frame the other
 // commands use (`render --light`, `export`):
 //   lumigauss env PANORAMA -o sh.txt [--up AXIS] [--rotate DEG] [--hdr-threshold T --hdr-scale S]
-//                 [--preview out.exr|out.png] [--width W] [--irradiance]
-//   lumigauss env --sh sh.txt --preview out.exr|out.png [--up AXIS] [--rotate DEG] [--width W] [--irradiance]
+//                 [--preview out.exr|out.png] [--preview-width W] [--irradiance]
+//   lumigauss env --sh sh.txt --preview out.exr|out.png [--up AXIS] [--rotate DEG] [--preview-width W] [--irradiance]
 // The projection is relight/light_source.h's panorama_light (shading/envmap.h: exact pixel solid angles), the
 // preview shading/envmap.h's render_sh_panorama, so a preview read back gives the same SH up to quadrature.
 #include <cctype>
@@ -49,7 +49,7 @@ void check_options(const EnvOptions& o) {
         fail_in_file(o.preview, "--preview must end in .exr (float radiance) or .png (clamped to [0, 1])");
     if (!(o.hdr_scale > 0) || !std::isfinite(o.hdr_scale) || !std::isfinite(o.hdr_threshold))
         throw Error("env: --hdr-scale must be positive and --hdr-threshold finite");
-    if (o.width < 2 || o.width % 2 != 0) throw Error("env: --width must be an even number >= 2");
+    if (o.width < 2 || o.width % 2 != 0) throw Error("env: --preview-width must be an even number >= 2");
 }
 
 // The environment the options name, in the world frame and turned by --rotate.
@@ -152,7 +152,7 @@ void register_env(CLI::App& app) {
     cmd->add_option("--sh", o->sh, "SH text file (9 lines R G B) to preview instead");
     cmd->add_option("-o,--output", o->out, "SH text file to write (9 lines R G B, radiance, world frame)");
     cmd->add_option("--preview", o->preview, "write the SH as a panorama: .exr (float) or .png (clamped)");
-    cmd->add_option("--width", o->width, "preview width in pixels (height = width / 2)")
+    cmd->add_option("--preview-width,--width", o->width, "preview width in pixels (height = width / 2)")
         ->capture_default_str();
     cmd->add_flag("--irradiance", o->irradiance, "preview the irradiance / pi instead of the radiance");
     cmd->add_option("--up", o->up,

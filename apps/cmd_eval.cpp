@@ -275,14 +275,14 @@ void register_eval(CLI::App& app) {
         ->check(CLI::IsMember({"gt-env", "sol-nerf", "holdout"}))
         ->capture_default_str();
     cmd->add_option("-o,--output", o->out, "report folder")->capture_default_str();
-    cmd->add_option("-r,--downscale", o->downscale,
+    cmd->add_option("-r,--resolution,--downscale", o->downscale,
                     "evaluate at 1/1, 1/2, 1/4 or 1/8 resolution (default: the run's training resolution)")
         ->check(CLI::IsMember({0, 1, 2, 4, 8}));
-    cmd->add_option(
-           "--views", o->views,
-           "gt-env and holdout. test: the protocol (novel views, novel lights); train: diagnostic, the "
-           "training views (gt-env: under their own true lights; separates lighting from novel-view "
-           "geometry)")
+    cmd->add_option("--cameras,--views", o->views,
+                    "which photos, gt-env and holdout. test: the protocol (novel views, novel lights); "
+                    "train: diagnostic, the "
+                    "training views (gt-env: under their own true lights; separates lighting from novel-view "
+                    "geometry)")
         ->check(CLI::IsMember({"test", "train"}))
         ->capture_default_str();
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)");

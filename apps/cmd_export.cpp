@@ -136,7 +136,8 @@ void register_export(CLI::App& app) {
     cmd->add_option("--hdr-threshold", o->hdr_threshold, "fake HDR for LDR panoramas: values above T ...")
         ->capture_default_str();
     cmd->add_option("--hdr-scale", o->hdr_scale, "... are multiplied by S")->capture_default_str();
-    cmd->add_option("--width", o->width, "env: width of the EXR previews (height = width / 2)")
+    cmd->add_option("--preview-width,--width", o->width,
+                    "env: width of the EXR previews (height = width / 2)")
         ->capture_default_str();
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)");
     cmd->callback([o] { run_export(*o); });

@@ -201,7 +201,8 @@ void register_fit_light(CLI::App& app) {
     cmd->add_option("--iterations", o->fit.iterations, "Adam iterations")
         ->check(CLI::Range(1, 1000000))
         ->capture_default_str();
-    cmd->add_option("-r,--downscale", o->downscale, "fit at 1/1, 1/2, 1/4 or 1/8 of the photo's resolution")
+    cmd->add_option("-r,--resolution,--downscale", o->downscale,
+                    "fit at 1/1, 1/2, 1/4 or 1/8 of the photo's resolution")
         ->check(CLI::IsMember({1, 2, 4, 8}))
         ->capture_default_str();
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)");

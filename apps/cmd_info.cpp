@@ -108,7 +108,7 @@ void register_info(CLI::App& app) {
                                        "SfM points and extent");
     cmd->add_option("scene", options->scene, "Scene folder (COLMAP sparse/0 + images/, or NeRF-OSR final/)")
         ->required();
-    cmd->add_option("-r,--resolution", options->downscale, "Downscale images by 1, 2, 4 or 8")
+    cmd->add_option("-r,--resolution,--downscale", options->downscale, "Downscale images by 1, 2, 4 or 8")
         ->check(CLI::IsMember({1, 2, 4, 8}));
     cmd->add_option("--masks", options->masks, "How train takes the masks: transient (default) or object")
         ->check(CLI::IsMember({"transient", "object"}));

@@ -160,7 +160,7 @@ void register_render(CLI::App& app) {
                     "with --cameras train|test|validation|all|orbit unless the run recorded its scene "
                     "(RUN/scene.json; a scene whose photos of the same names have other cameras is refused)");
     cmd->add_option("-o,--output", o->out, "output folder")->capture_default_str();
-    cmd->add_option("-r,--downscale", o->downscale,
+    cmd->add_option("-r,--resolution,--downscale", o->downscale,
                     "downscale images by 1, 2, 4 or 8 (default: 1 for --ply, the run's training "
                     "resolution for a run; a camera JSON is used as is unless given)")
         ->check(CLI::IsMember({1, 2, 4, 8}));

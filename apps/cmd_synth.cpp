@@ -1,4 +1,4 @@
-// `lumigauss synth -o DIR [--preset tiny|demo|bench] [--scene plaza|temple] ...`: render a procedural
+// `lumigauss synth -o DIR [--preset tiny|demo|bench] [--landmark plaza|temple] ...`: render a procedural
 // landmark into a dataset in the form users bring (COLMAP + images + masks) plus ground truth in
 // data/plaza's layout. A preset sets every default; explicit flags override it.
 #include <cstdio>
@@ -44,7 +44,7 @@ void run_synth(const SynthFlags& f) {
     const synth::SynthOptions o = to_options(f);
     const synth::SynthSummary s = synth::generate_synthetic_scene(o);
     std::printf(
-        "synth: wrote %s: scene %s, %dx%d, %d train (%d with pedestrians) + %d test photos, %d lighting "
+        "synth: wrote %s: landmark %s, %dx%d, %d train (%d with pedestrians) + %d test photos, %d lighting "
         "conditions, %d points3D, %d ground-truth surfels in %.2f s\n",
         o.output_dir.c_str(), o.scene.c_str(), o.width, o.height, s.n_train, s.n_with_transients, s.n_test,
         s.n_conditions, s.n_points, s.n_gt_surfels, s.seconds);
@@ -64,7 +64,7 @@ void register_synth(CLI::App& app) {
                     "tiny (64x48, 8+2 photos), demo (160x120, 40+6), bench (320x240, 60+12)")
         ->check(CLI::IsMember({"tiny", "demo", "bench"}))
         ->capture_default_str();
-    cmd->add_option("--scene", f->scene, "Landmark: plaza or temple")
+    cmd->add_option("--landmark,--scene", f->scene, "Landmark: plaza or temple (--scene: the old name)")
         ->check(CLI::IsMember({"plaza", "temple"}))
         ->capture_default_str();
     f->o_width = cmd->add_option("--width", f->width, "Image width in pixels")->check(CLI::Range(8, 8192));

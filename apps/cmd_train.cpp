@@ -232,7 +232,7 @@ void register_train(CLI::App& app) {
                     "Total iterations; the preset's schedule (stages, densification, resets) scales with it "
                     "(with --resume: only extends the run)")
         ->check(CLI::PositiveNumber);
-    cmd->add_option("-r,--resolution", f->downscale,
+    cmd->add_option("-r,--resolution,--downscale", f->downscale,
                     "Downscale the photos by 1, 2, 4 or 8; auto (the default) takes the smallest factor that "
                     "brings the longest photo side to at most 1600 px, and says so")
         ->check(CLI::IsMember({"auto", "1", "2", "4", "8"}));

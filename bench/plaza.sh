@@ -112,7 +112,7 @@ for i in "${!names[@]}"; do
     echo "== $name: evaluating (gt-env, test views, then training views)"
     test_line=$("$bin" eval "$run" --scene "$scene" --protocol gt-env -o "$run/eval" | tee /dev/stderr |
                 grep '^eval-summary:')
-    train_line=$("$bin" eval "$run" --scene "$scene" --protocol gt-env --views train --no-sheets \
+    train_line=$("$bin" eval "$run" --scene "$scene" --protocol gt-env --cameras train --no-sheets \
                  -o "$run/eval_train" | grep '^eval-summary:')
     surfels=$(awk -F'"surfels":' 'NF > 1 { split($2, a, /[,}]/); s = a[1] } END { print s }' "$run/log.jsonl")
     echo "$name $(train_seconds "$run") $surfels $(summary_value "$train_line" normal_median_deg)" \

@@ -107,7 +107,7 @@ TEST(CliEval, TrainViewsDiagnostic) {
     const std::string report = tmp / "report";
     const CommandResult r =
         run_lumigauss("eval " + shell_quoted(t.run) + " --scene " + shell_quoted(t.scene) +
-                          " --views train --no-sheets -o " + shell_quoted(report),
+                          " --cameras train --no-sheets -o " + shell_quoted(report),
                       tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     const nlohmann::json j = synth_test::read_json(report + "/metrics.json");

@@ -63,6 +63,13 @@ TEST(CliInfo, SmallSceneExtent) {
     EXPECT_TRUE(contains(r.output, "mean (1, 0, -5), extent 1.1 ")) << r.output;
     EXPECT_TRUE(contains(r.output, "sky masks:     0 of 3 views (the sky is then found")) << r.output;
     EXPECT_TRUE(contains(r.output, "min (-1, 0, 0), max (1, 2, 3)")) << r.output;
+    // -r has one meaning and both long names on every command.
+    const CommandResult half = run_lumigauss("info -r 2 '" + (tmp / "scene") + "'", tmp);
+    ASSERT_EQ(half.exit_code, 0) << half.output;
+    EXPECT_TRUE(contains(half.output, "resolutions:   4x3 (3)")) << half.output;
+    for (const char* name : {"--resolution", "--downscale"})
+        EXPECT_EQ(run_lumigauss(std::string("info ") + name + " 2 '" + (tmp / "scene") + "'", tmp).output,
+                  half.output);
     const CommandResult quiet = run_lumigauss("info -q '" + (tmp / "scene") + "'", tmp);
     ASSERT_EQ(quiet.exit_code, 0) << quiet.output;
     EXPECT_EQ(quiet.output,

@@ -20,13 +20,22 @@ TEST(SynthCli, WritesTheTinyPresetWithOverrides) {
     TempDir tmp("synth_cli");
     const std::string out = tmp.sub("temple");
     const CommandResult r = run_lumigauss(
-        "synth --preset tiny --scene temple --train 4 --test 1 --width 40 --height 30 -o '" + out + "'", tmp);
+        "synth --preset tiny --landmark temple --train 4 --test 1 --width 40 --height 30 -o '" + out + "'",
+        tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    EXPECT_NE(r.output.find("scene temple, 40x30, 4 train"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("landmark temple, 40x30, 4 train"), std::string::npos) << r.output;
     const Dataset d = load_dataset(out, DatasetOptions{});
     EXPECT_EQ(d.views.size(), 5u);
     EXPECT_EQ(d.views[0].camera.width, 40);
     EXPECT_EQ(synth_test::read_json(out + "/meta.json")["scene"], "temple");
+
+    // The old name of --landmark still works.
+    const CommandResult old_name =
+        run_lumigauss("synth --preset tiny --scene temple --train 2 --test 0 --width 16 --height 12 -o '" +
+                          tmp.sub("old") + "'",
+                      tmp);
+    ASSERT_EQ(old_name.exit_code, 0) << old_name.output;
+    EXPECT_NE(old_name.output.find("landmark temple, 16x12"), std::string::npos) << old_name.output;
 
     const CommandResult again = run_lumigauss("synth --preset tiny -o '" + out + "'", tmp);
     EXPECT_EQ(again.exit_code, 1) << again.output;

@@ -241,7 +241,7 @@ std::string gt_env_report_markdown(const GtEnvResult& r, const ReportSources& sr
          " test images\n\n";
     s += "## Protocol\n\n";
     if (r.views == Split::Train)
-        s += "- **Diagnostic run on the TRAINING views** (`--views train`), each under its own true light; "
+        s += "- **Diagnostic run on the TRAINING views** (`--cameras train`), each under its own true light; "
              "the "
              "light scale is fitted on the same photos. The protocol proper scores the test views.\n";
     s += "- Each test photo is rendered under `k * exposure * (true SH of its condition)`: no rotation "

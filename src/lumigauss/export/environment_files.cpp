@@ -39,7 +39,7 @@ std::vector<std::string> write_environment_files(const std::string& dir,
                                                  int preview_width) {
     if (envs.empty())
         throw Error("--format env: the model has no learned environments (a bare PLY has none)");
-    if (preview_width < 2) throw Error("--width must be at least 2");
+    if (preview_width < 2) throw Error("--preview-width must be at least 2");
     std::filesystem::create_directories(dir);
     std::vector<std::string> names;
     for (const auto& e : envs) names.push_back(e.name);

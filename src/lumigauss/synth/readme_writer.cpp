@@ -31,7 +31,7 @@ std::string header(const MetaInputs& in) {
          "under many lightings. Ground-truth albedo, normals, masks, sun visibility and environment SH are "
          "provided. ";
     s += format(
-        "Generation parameters: `--scene %s --width %d --height %d --train %d --test %d --seed %llu "
+        "Generation parameters: `--landmark %s --width %d --height %d --train %d --test %d --seed %llu "
         "--transients %g --spp-side %d --points %d --gt-surfels %d`.\n\n",
         o.scene.c_str(), o.width, o.height, o.n_train, o.n_test, static_cast<unsigned long long>(o.seed),
         o.transient_fraction, o.samples_per_side, o.point_candidates, o.gt_surfels);
