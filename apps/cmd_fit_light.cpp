@@ -14,6 +14,7 @@
 #include "lumigauss/cameras/camera_json.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
+#include "lumigauss/io/lens_distortion.h"
 #include "lumigauss/model/render_model.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_fit.h"
@@ -91,6 +92,7 @@ Image read_mask_file(const std::string& path, int width, int height) {
 
 FitInput load_input(const FitLightOptions& o) {
     FitInput in;
+    LensDistortion lens;  // of the scene's camera; none for a camera JSON
     if (is_camera_json(o.camera)) {
         if (o.image.empty()) throw Error("fit-light: --camera " + o.camera + " needs --image PHOTO");
         in.camera = camera_from_json(o.camera, o.image);
@@ -102,11 +104,15 @@ FitInput load_input(const FitLightOptions& o) {
         const Dataset scene = load_dataset(o.scene, DatasetOptions{});
         const View& view = find_view(scene, o.camera);
         in.camera = view.camera;
-        // Without --image, the scene's own photo and mask of that view.
         in.photo_path = o.image.empty() ? view.image_path : o.image;
-        if (o.image.empty() && o.mask.empty()) in.mask = scene.load_mask(view);
+        if (o.image.empty()) {
+            // The scene's own photo and mask of that view, undistorted as for training.
+            in.photo = scene.load_image(view);
+            if (o.mask.empty()) in.mask = scene.load_mask(view);
+        }
+        lens = view.lens;
     }
-    in.photo = to_channels(read_image(in.photo_path), 3);
+    if (in.photo.empty()) in.photo = to_channels(read_image(in.photo_path), 3);
     const Image& p = in.photo;
     if (p.width != in.camera.width || p.height != in.camera.height) {
         const double a = double(p.width) / p.height, b = double(in.camera.width) / in.camera.height;
@@ -117,6 +123,15 @@ FitInput load_input(const FitLightOptions& o) {
         in.camera = in.camera.resized(p.width, p.height);
     }
     if (!o.mask.empty()) in.mask = read_mask_file(o.mask, p.width, p.height);
+    if (!o.image.empty() && !lens.is_identity()) {
+        // A photo of that camera taken through its lens (io/lens_distortion.h): onto the pinhole, with the
+        // pixels it does not cover left out of the fit.
+        in.photo = undistort_image(in.photo, in.camera, lens);
+        if (!in.mask.empty())
+            in.mask = undistort_image(in.mask, in.camera, lens);
+        else
+            in.mask = undistort_validity(in.camera, lens);
+    }
     return in;
 }
 

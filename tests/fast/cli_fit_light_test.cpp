@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "lumigauss/cameras/camera_json.h"
@@ -104,6 +106,44 @@ TEST(CliFitLight, FitsThroughTheEmbeddingWithACameraJson) {
     const TrainedRun run = load_trained_run(s.run);
     const ShCoeffs<double> mean = default_initial_sh(run);  // the mean learned light
     EXPECT_GT(s.psnr_with(read_sh_text(out)), s.psnr_with(mean) + 3.0);
+}
+
+// The scene's cameras given a lens (OPENCV, k1 = -0.2): fitting by camera name uses the photo undistorted as
+// training does, the same as passing the lens photo and its mask with --image/--mask, and not the photo as
+// if taken by the pinhole (which fit-light did while the mask was already undistorted).
+TEST(CliFitLight, ALensCameraFitsTheUndistortedPhoto) {
+    const FitSetup& s = setup();
+    ASSERT_EQ(s.train.exit_code, 0) << s.train.output;
+    TempDir tmp("cli_fit_light_lens");
+    const std::string lens = tmp / "lens";
+    fs::copy(s.scene, lens, fs::copy_options::recursive);
+    std::string cameras;
+    std::istringstream lines(synth_test::read_bytes(lens + "/sparse/0/cameras.txt"));
+    for (std::string line; std::getline(lines, line);) {
+        if (const std::size_t at = line.find(" PINHOLE "); at != std::string::npos)
+            line = line.replace(at, 9, " OPENCV ") + " -0.2 0 0 0";
+        cameras += line + "\n";
+    }
+    std::ofstream(lens + "/sparse/0/cameras.txt", std::ios::binary) << cameras;
+    const auto fit = [&](const std::string& scene, const std::string& extra, const std::string& out) {
+        const CommandResult r = run_lumigauss(
+            "fit-light " + shell_quoted(s.run) + " --scene " + shell_quoted(scene) + " --camera " +
+                shell_quoted(s.view.name) + extra + " --via sh --iterations 100 -q -o " + shell_quoted(out),
+            tmp);
+        EXPECT_EQ(r.exit_code, 0) << r.output;
+        return synth_test::read_bytes(out);
+    };
+    const std::string by_name = fit(lens, "", tmp / "name.txt");
+    const std::string mask =
+        s.view.mask_path.empty()
+            ? ""
+            : " --mask " + shell_quoted(lens + "/masks/" + fs::path(s.view.mask_path).filename().string());
+    const std::string by_image =
+        fit(lens, " --image " + shell_quoted(lens + "/images/" + s.view.name) + mask, tmp / "image.txt");
+    const std::string pinhole = fit(s.scene, "", tmp / "pinhole.txt");
+    ASSERT_FALSE(by_name.empty());
+    EXPECT_EQ(by_name, by_image);
+    EXPECT_NE(by_name, pinhole);
 }
 
 TEST(CliFitLight, BadInputFailsNamingTheProblem) {
