@@ -107,11 +107,10 @@ Image Dataset::load_image(const View& view) const {
 }
 
 Image Dataset::load_mask(const View& view) const {
-    if (view.mask_path.empty() && view.lens.is_identity())
-        return Image(view.camera.width, view.camera.height, 1, 1.0f);
+    // Without a mask file every pixel counts that the (undistorted) photo covers.
     if (view.mask_path.empty())
-        return fit_to_view(Image(view.source_width, view.source_height, 1, 1.0f), view, view.image_path,
-                           "image");
+        return view.lens.is_identity() ? Image(view.camera.width, view.camera.height, 1, 1.0f)
+                                       : load_coverage(view);
     return fit_to_view(to_channels(read_image(view.mask_path), 1), view, view.mask_path, "mask");
 }
 
