@@ -32,7 +32,7 @@ struct RenderOptions {
     std::string backend = "cpu";
     std::string background_text;  // "sky" or "R,G,B"
     std::vector<float> background{0, 0, 0};
-    bool background_given = false, sky_background = false, split_given = false;
+    bool background_given = false, sky_background = false, split_given = false, cameras_given = false;
     bool extra_maps = false;
     // Run mode (relight_job.h).
     std::string run, outputs = "all";
@@ -111,6 +111,15 @@ void run_render(RenderOptions o) {
     const RasterBackend backend = choose_backend(o.backend);
     if (!o.run.empty()) return run_relight(o, backend);
     if (o.scene.empty()) throw Error("render --ply needs --scene (the cameras to render from)");
+    if (o.cameras_given) {
+        // The one vocabulary (README): --cameras names the views for a PLY too; --split is its old spelling.
+        const std::string& c = o.job.cameras;
+        if (c != "all" && c != "train" && c != "test" && c != "validation")
+            throw Error("--cameras '" + c +
+                        "': render --ply renders the scene's views: all, train, test or "
+                        "validation (orbits and camera JSON files are for runs)");
+        o.split = c;
+    }
     DatasetOptions dopt;
     dopt.downscale = o.downscale > 0 ? o.downscale : 1;
     const Dataset scene = load_dataset(o.scene, dopt);
@@ -164,7 +173,7 @@ void register_render(CLI::App& app) {
                     "downscale images by 1, 2, 4 or 8 (default: 1 for --ply, the run's training "
                     "resolution for a run; a camera JSON is used as is unless given)")
         ->check(CLI::IsMember({1, 2, 4, 8}));
-    cmd->add_option("--split", o->split, "--ply: which views: all, train, test, validation")
+    cmd->add_option("--split", o->split, "--ply: which views (the old spelling of --cameras for a PLY)")
         ->check(CLI::IsMember({"all", "train", "test", "validation"}))
         ->capture_default_str();
     cmd->add_option("--background", o->background_text,
@@ -189,7 +198,7 @@ void register_render(CLI::App& app) {
     cmd->add_option("--cameras", j.cameras,
                     "train, test, validation, all (the scene's views), orbit (a turntable around the "
                     "scene's SfM centre at its cameras' mean height and distance, intrinsics of its first "
-                    "view), or a camera JSON file")
+                    "view), or a camera JSON file; --ply: all (default), train, test or validation")
         ->capture_default_str()
         ->group(run_group);
     cmd->add_option("--view", j.views, "render only this camera (image name or its stem; repeatable)")
@@ -248,6 +257,7 @@ void register_render(CLI::App& app) {
         RenderOptions opts = *o;
         opts.background_given = cmd->count("--background") > 0;
         opts.split_given = cmd->count("--split") > 0;
+        opts.cameras_given = cmd->count("--cameras") > 0;
         run_render(opts);
     });
 }

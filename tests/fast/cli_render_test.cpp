@@ -60,6 +60,38 @@ TEST(CliRender, WritesOnePngPerViewMatchingTheLibrary) {
     }
 }
 
+// --cameras names a PLY's views as it names a run's (--split is the old spelling); orbits are for runs.
+TEST(CliRender, CamerasChooseThePlyViews) {
+    TempDir dir;
+    test::write_scene(dir.path() / "scene", test::small_model(2, 24, 16));
+    ViewDependentSurfels m;
+    m.sh_degree = 0;
+    m.surfels.resize(1);
+    m.sh.assign(3, 0.f);
+    m.surfels.quats[0] = 1.f, m.surfels.scales[0] = m.surfels.scales[1] = 0.2f, m.surfels.opacities[0] = 0.8f;
+    save_2dgs_ply(dir / "model.ply", m);
+    const Dataset scene = load_dataset(dir / "scene");
+    const auto pngs = [](const std::filesystem::path& folder) {
+        std::size_t count = 0;
+        for (const auto& e : std::filesystem::directory_iterator(folder))
+            count += e.path().extension() == ".png";
+        return count;
+    };
+    const std::string base = std::string(LUMIGAUSS_BINARY) + " render --ply " + (dir / "model.ply") +
+                             " --scene " + (dir / "scene") + " -o ";
+    for (const char* option : {"--cameras", "--split"}) {
+        const std::string out = dir / (std::string("out") + option);
+        const std::string cmd = base + out + " " + option + " test > " + (dir / "log.txt") + " 2>&1";
+        ASSERT_EQ(std::system(cmd.c_str()), 0) << test::read_text(dir / "log.txt");
+        EXPECT_EQ(pngs(out), scene.split(Split::Test).size()) << option;
+        EXPECT_LT(pngs(out), scene.views.size());
+    }
+    const std::string orbit = base + (dir / "orbit") + " --cameras orbit > " + (dir / "log.txt") + " 2>&1";
+    EXPECT_NE(std::system(orbit.c_str()), 0);
+    EXPECT_NE(test::read_text(dir / "log.txt").find("--cameras 'orbit'"), std::string::npos)
+        << test::read_text(dir / "log.txt");
+}
+
 TEST(CliRender, BadModelGivesAnErrorNamingTheFile) {
     TempDir dir;
     test::write_scene(dir.path() / "scene", test::small_model(1, 16, 16));
