@@ -1,7 +1,10 @@
 // `lumigauss export SOURCE --format F [--light L] -o FILE`: converts a trained run (or a bare relightable
 // PLY in the official LumiGauss layout) into files other tools open (docs/formats.md):
-//   ply-3dgs         standard 3DGS PLY, colours baked under --light (export/ply_3dgs.h)
-//   splat            the 32-byte-per-splat web format, baked under --light (export/splat_format.h)
+//   ply-3dgs         standard 3DGS PLY, colours baked under --light, both sides of each surfel in
+//   view-dependent
+//                    SH of --sh-degree (export/ply_3dgs.h, export/two_sided_sh.h)
+//   splat            the 32-byte-per-splat web format, baked under --light, the side the training photos see
+//                    (export/splat_format.h)
 //   ply-relightable  the relightable PLY plus FILE.environments.json (export/relightable_bundle.h)
 //   env              folder of per-photo SH text files and EXR previews (export/environment_files.h)
 // Everything is loaded and checked before anything is written.
@@ -18,6 +21,7 @@
 #include "lumigauss/export/ply_3dgs.h"
 #include "lumigauss/export/relightable_bundle.h"
 #include "lumigauss/export/splat_format.h"
+#include "lumigauss/export/two_sided_sh.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_source.h"
 #include "lumigauss/util/error.h"
@@ -30,6 +34,8 @@ struct ExportOptions {
     double rotate_degrees = 0, exposure = 1.0, hdr_threshold = 0.99, hdr_scale = 1.0;
     bool match_exposure = false;
     int width = 512;
+    int sh_degree = 3;
+    bool sh_degree_given = false;
     int threads = 0;
     bool quiet = false;
 };
@@ -41,6 +47,12 @@ bool baked_format(const std::string& f) {
 void make_parent(const std::string& path) {
     const std::filesystem::path parent = std::filesystem::path(path).parent_path();
     if (!parent.empty()) std::filesystem::create_directories(parent);
+}
+
+// Which side a one-colour export shows (seen_side_colours).
+const char* seen_side_note(const TrainedRun& run) {
+    return run.photo_centres.empty() ? "the +normal side (no training cameras recorded)"
+                                     : "the side the training photos see";
 }
 
 void run_export(const ExportOptions& o) {
@@ -60,6 +72,10 @@ void run_export(const ExportOptions& o) {
     if (!baked && !o.light.empty())
         throw Error("--light is for the baked formats (ply-3dgs, splat), not " + o.format);
     const BakeShading shading = parse_bake_shading(o.shading);
+    if (o.sh_degree_given && o.format != "ply-3dgs")
+        throw Error("--sh-degree is for --format ply-3dgs (" + o.format + " holds no view-dependent colour)");
+    if (o.sh_degree < 0 || o.sh_degree > 3)
+        throw Error("--sh-degree " + std::to_string(o.sh_degree) + ": use 0, 1, 2 or 3");
 
     const TrainedRun run = load_run_or_ply(source);
     // auto: the up of the training photos the run recorded; +z for a bare PLY.
@@ -73,16 +89,23 @@ void run_export(const ExportOptions& o) {
         double factor = o.exposure;
         if (o.match_exposure) factor *= match_exposure_factor(light.sh, run);
         const ShCoeffs<double> env = rotate_about_up(scaled(light.sh, factor), up, o.rotate_degrees);
-        const std::vector<float> colours = bake_surfel_colours(run.model, env.cast<float>(), shading);
+        const SurfelSides sides = bake_surfel_sides(run.model, env.cast<float>(), shading);
         make_parent(o.out);
-        if (o.format == "ply-3dgs")
-            write_3dgs_ply(o.out, run.model, colours);
-        else
-            write_splat_file(o.out, splat_records(run.model, colours));
+        std::string how;
+        if (o.format == "ply-3dgs") {
+            write_3dgs_ply(o.out, run.model,
+                           two_sided_view_sh(run.model, sides, o.sh_degree, run.photo_centres), o.sh_degree);
+            how = o.sh_degree > 0 ? "both sides, SH degree " + std::to_string(o.sh_degree)
+                                  : std::string("one colour: ") + seen_side_note(run);
+        } else {
+            write_splat_file(
+                o.out, splat_records(run.model, seen_side_colours(run.model, sides, run.photo_centres)));
+            how = std::string("one colour: ") + seen_side_note(run);
+        }
         if (!o.quiet)
-            std::printf("export: %zu surfels baked (%s, %s '%s') to %s (%s)\n", run.model.size(),
-                        o.shading.c_str(), light_kind_name(light.kind), light.source.c_str(), o.out.c_str(),
-                        o.format.c_str());
+            std::printf("export: %zu surfels baked (%s, %s '%s'; %s) to %s (%s)\n", run.model.size(),
+                        o.shading.c_str(), light_kind_name(light.kind), light.source.c_str(), how.c_str(),
+                        o.out.c_str(), o.format.c_str());
         return;
     }
     if (o.format == "ply-relightable") {
@@ -121,8 +144,17 @@ void register_export(CLI::App& app) {
                     "ply-3dgs/splat: the lighting to bake, as for `render --light` (training photo, SH .txt, "
                     "panorama; prefixes photo:, sh:, pano:)");
     cmd->add_option("--shading", o->shading,
-                    "baked colour: shadowed (the full model, positive transfer set) or unshadowed (+normal)")
+                    "baked colour: shadowed (the full model: transfer sets) or unshadowed (the normals)")
         ->capture_default_str();
+    cmd->add_option_function<int>(
+           "--sh-degree",
+           [o](int degree) {
+               o->sh_degree = degree;
+               o->sh_degree_given = true;
+           },
+           "ply-3dgs: degree of the view-dependent colour (0: one colour, the side the training photos see; "
+           "1-3: each side of a surfel shows its own colour; default 3)")
+        ->type_name("INT");
     cmd->add_option("--up", o->up,
                     "world up (panorama lights, --rotate, the bundle's up): +z, -y, +y, +x, -x, -z, a vector "
                     "X,Y,Z, or auto (the run's training photos; +z for a bare PLY)")

@@ -76,7 +76,18 @@ TEST(CliExport, EveryFormatAndImportFromBarePly) {
                           shell_quoted(photos[0]) + " -o " + shell_quoted(tmp / "baked/photo.ply"),
                       tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("both sides, SH degree 3"));
     EXPECT_EQ(load_2dgs_ply(tmp / "baked/photo.ply").size(), surfels);
+    EXPECT_EQ(load_2dgs_ply(tmp / "baked/photo.ply").sh_degree, 3);
+    // --sh-degree 0: one colour, the side the run's recorded training photos see.
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format ply-3dgs --sh-degree 0 --light " +
+                          shell_quoted(photos[0]) + " -o " + shell_quoted(tmp / "baked/one.ply"),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("the side the training photos see"));
+    EXPECT_EQ(load_2dgs_ply(tmp / "baked/one.ply").sh_degree, 0);
+    // 17 floats per surfel instead of 62.
+    EXPECT_LT(3 * fs::file_size(tmp / "baked/one.ply"), fs::file_size(tmp / "baked/photo.ply"));
 
     // Import: the bare model.ply (official layout) with that photo's SH text file bakes the same bytes.
     fs::path stem = fs::path(photos[0]).replace_extension();
@@ -137,6 +148,21 @@ TEST(CliExport, BadInputNamesTheProblem) {
     EXPECT_NE(r.exit_code, 0);
     EXPECT_THAT(r.output, HasSubstr("nope.txt"));
     EXPECT_FALSE(fs::exists(tmp / "m.ply"));
+
+    // --sh-degree: 0..3, and only for ply-3dgs.
+    const std::string light = shell_quoted(load_appearance(run_paths(t.run).appearance).at(0));
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format ply-3dgs --sh-degree 4 --light " + light +
+                          " -o " + shell_quoted(tmp / "m.ply"),
+                      tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("--sh-degree 4"));
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format splat --sh-degree 1 --light " + light +
+                          " -o " + shell_quoted(tmp / "m.splat"),
+                      tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("--sh-degree is for --format ply-3dgs"));
+    EXPECT_FALSE(fs::exists(tmp / "m.ply"));
+    EXPECT_FALSE(fs::exists(tmp / "m.splat"));
 
     // A bare PLY has no photos to export.
     r = run_lumigauss(

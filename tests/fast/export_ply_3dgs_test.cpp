@@ -1,10 +1,12 @@
-// `export --format ply-3dgs` (export/ply_3dgs.h, export/baked_colours.h): the file is a standard 3DGS PLY
-// (checked by a strict reader written here: exact header, property list and order, binary little-endian,
-// exact byte count), its values are the baked colours / copied geometry, and rendering it back through the
-// project's 2DGS path (load_2dgs_ply + colors_for_view + rasterize_forward_cpu) matches
-// render_with_environment of the relightable model for surfels whose +normal faces the camera.
+// `export --format ply-3dgs` (export/ply_3dgs.h, export/two_sided_sh.h, export/baked_colours.h): the file
+// is a standard 3DGS PLY (checked by a strict reader written here: exact header, property list and order for
+// each SH degree, binary little-endian, exact byte count), its geometry is the model's, and rendered by this
+// file's own 3DGS colour evaluation (the Inria `eval_sh` constants written out here, channel-major f_rest)
+// it reproduces the relightable render from cameras on BOTH sides of the surfels: the baked colours of the
+// two sides of a two-sided surfel.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -13,11 +15,12 @@
 #include <random>
 #include <sstream>
 
+#include "lumigauss/cameras/orbit.h"
 #include "lumigauss/export/baked_colours.h"
 #include "lumigauss/export/ply_3dgs.h"
+#include "lumigauss/export/two_sided_sh.h"
 #include "lumigauss/math/quaternion.h"
 #include "lumigauss/model/render_model.h"
-#include "lumigauss/model/splat_ply.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/util/error.h"
 #include "relight_test_util.h"
@@ -29,10 +32,11 @@ namespace {
 
 using lumigauss::testing::TempDir;
 
-// The 3DGS property list, written out independently of the exporter.
-std::vector<std::string> expected_properties() {
+// The 3DGS property list for an SH degree, written out independently of the exporter.
+std::vector<std::string> expected_properties(int degree) {
     std::vector<std::string> p = {"x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2"};
-    for (int k = 0; k < 45; ++k) p.push_back("f_rest_" + std::to_string(k));
+    const int rest = degree == 0 ? 0 : degree == 1 ? 9 : degree == 2 ? 24 : 45;
+    for (int k = 0; k < rest; ++k) p.push_back("f_rest_" + std::to_string(k));
     for (const char* s : {"opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"})
         p.push_back(s);
     return p;
@@ -99,120 +103,265 @@ StrictPly read_strict_ply(const std::string& path) {
     return ply;
 }
 
-// A random relightable model whose surfels all show their +normal side to `cam` (tilted by up to ~0.2 rad
-// from facing it straight on), so that the bake's side choice is the one a renderer makes.
-GaussianModel facing_model(const Camera& cam, std::uint64_t seed, std::size_t count = 80) {
-    auto raw = relight_test::random_raw(cam, seed, count);
+// The colour a 3DGS renderer gives vertex `row` seen along the unit direction `d` (camera -> splat): the
+// Inria code's eval_sh (its SH_C0..SH_C3 and term order), f_rest channel-major, + 0.5, clamped at 0.
+Vec3d inria_colour(const StrictPly& ply, std::size_t row, int degree, Vec3d d) {
+    const double C0 = 0.28209479177387814, C1 = 0.4886025119029199;
+    const double C2[] = {1.0925484305920792, -1.0925484305920792, 0.31539156525252005, -1.0925484305920792,
+                         0.5462742152960396};
+    const double C3[] = {-0.5900435899266435, 2.890611442640554, -0.4570457994644658, 0.3731763325901154,
+                         -0.4570457994644658, 1.445305721320277, -0.5900435899266435};
+    const int per_channel = (degree + 1) * (degree + 1) - 1;
+    Vec3d out;
+    for (int c = 0; c < 3; ++c) {
+        const auto f = [&](int k) {  // coefficient k >= 1 of channel c
+            return double(ply.at(row, "f_rest_" + std::to_string(c * per_channel + k - 1)));
+        };
+        const double x = d.x, y = d.y, z = d.z, xx = x * x, yy = y * y, zz = z * z;
+        double v = C0 * ply.at(row, "f_dc_" + std::to_string(c));
+        if (degree > 0) v += -C1 * y * f(1) + C1 * z * f(2) - C1 * x * f(3);
+        if (degree > 1)
+            v += C2[0] * x * y * f(4) + C2[1] * y * z * f(5) + C2[2] * (2 * zz - xx - yy) * f(6) +
+                 C2[3] * x * z * f(7) + C2[4] * (xx - yy) * f(8);
+        if (degree > 2)
+            v += C3[0] * y * (3 * xx - yy) * f(9) + C3[1] * x * y * z * f(10) +
+                 C3[2] * y * (4 * zz - xx - yy) * f(11) + C3[3] * z * (2 * zz - 3 * xx - 3 * yy) * f(12) +
+                 C3[4] * x * (4 * zz - xx - yy) * f(13) + C3[5] * z * (xx - yy) * f(14) +
+                 C3[6] * x * (xx - 3 * yy) * f(15);
+        out[c] = std::max(0.0, v + 0.5);
+    }
+    return out;
+}
+
+// The file's splats as the rasterizer takes them, coloured for a camera at `eye` by inria_colour.
+SurfelBatch<float> splats_for_view(const StrictPly& ply, int degree, Vec3d eye) {
+    SurfelBatch<float> b;
+    b.channels = 3;
+    b.resize(ply.count);
+    for (std::size_t i = 0; i < ply.count; ++i) {
+        const Vec3d mean{ply.at(i, "x"), ply.at(i, "y"), ply.at(i, "z")};
+        for (int k = 0; k < 3; ++k) b.means[3 * i + std::size_t(k)] = float(mean[k]);
+        for (int k = 0; k < 4; ++k) b.quats[4 * i + std::size_t(k)] = ply.at(i, "rot_" + std::to_string(k));
+        for (int k = 0; k < 2; ++k)
+            b.scales[2 * i + std::size_t(k)] = std::exp(ply.at(i, "scale_" + std::to_string(k)));
+        b.opacities[i] = float(1.0 / (1.0 + std::exp(-double(ply.at(i, "opacity")))));
+        const Vec3d rgb = inria_colour(ply, i, degree, normalize(mean - eye));
+        for (int c = 0; c < 3; ++c) b.colors[3 * i + std::size_t(c)] = float(rgb[c]);
+    }
+    return b;
+}
+
+// `count` surfels in the cube [-1, 1]^3 with random orientations: about half show each side to any camera.
+GaussianModel cube_model(std::uint64_t seed, std::size_t count = 120) {
+    auto raw = relight_test::random_raw(lumigauss::testing::test_camera(), seed, count);
     std::mt19937_64 rng(seed + 1);
-    const Mat3d world_from_cam = transpose(cam.rotation);
     for (std::size_t i = 0; i < count; ++i) {
-        // 180 deg about camera x (local +z -> camera -z, towards the camera), perturbed.
-        const Vec4<double> qc = normalize_quaternion(Vec4<double>{0.1 * relight_test::uniform(rng), 1.0,
-                                                                  0.1 * relight_test::uniform(rng),
-                                                                  0.1 * relight_test::uniform(rng)});
-        const Vec4<double> q = quaternion_from_rotation(world_from_cam * rotation_from_unit_quaternion(qc));
-        const double s = 0.5 + relight_test::uniform(rng, 0.0, 1.0);  // unnormalised on purpose
-        for (int k = 0; k < 4; ++k) raw[int(ModelParam::Rotation)][4 * i + std::size_t(k)] = float(s * q[k]);
+        for (int k = 0; k < 3; ++k)
+            raw[int(ModelParam::Xyz)][3 * i + std::size_t(k)] = float(relight_test::uniform(rng));
+        for (int k = 0; k < 4; ++k)
+            raw[int(ModelParam::Rotation)][4 * i + std::size_t(k)] = float(relight_test::uniform(rng));
+        for (int k = 0; k < 2; ++k)
+            raw[int(ModelParam::Scaling)][2 * i + std::size_t(k)] =
+                float(relight_test::uniform(rng, -2.2, -1.4));
+        raw[int(ModelParam::Opacity)][i] = float(relight_test::uniform(rng, 0.0, 3.0));
+        // The back sides mostly in shadow: their transfer's DC at a third of the front's.
+        raw[int(ModelParam::TransferNegative)][i * kTransferStored] =
+            float(relight_test::uniform(rng, 0.2, 0.5));
     }
     return GaussianModel::from_raw(std::move(raw), 1.0);
 }
 
-// A moderate environment: colours stay below 1, so the [0, 1] clamp of the bake is inactive.
+// Cameras around the cube: six on a tilted ring and one above, 3.5 units from the centre.
+std::vector<Camera> ring_cameras() {
+    const Camera intrinsics = lumigauss::testing::test_camera(64, 48);
+    std::vector<Camera> cams;
+    for (int k = 0; k < 6; ++k) {
+        const double a = 2 * 3.141592653589793 * k / 6;
+        cams.push_back(look_at(intrinsics, {3.5 * std::cos(a), 3.5 * std::sin(a), std::cos(3 * a)}, {0, 0, 0},
+                               {0, 0, 1}));
+    }
+    cams.push_back(look_at(intrinsics, {0.3, 0.2, 3.5}, {0, 0, 0}, {0, 1, 0}));
+    return cams;
+}
+
+// A moderate environment with a strong direction (band 1): colours stay mostly below 1, and the two sides
+// of a surfel differ in unshadowed shading too.
 ShCoeffs<float> moderate_env() {
     ShCoeffs<double> sh = relight_test::bright_sh(11);
-    for (int k = 0; k < kShCount; ++k) sh.c[k] = sh.c[k] * (k == 0 ? 0.5 : 0.15);
+    for (int k = 0; k < kShCount; ++k) sh.c[k] = sh.c[k] * (k == 0 ? 0.5 : k < 4 ? 0.6 : 0.15);
     return sh.cast<float>();
 }
 
-TEST(ExportPly3dgs, StrictHeaderAndValues) {
+// PSNR of two colour maps, both clamped to the display range [0, 1].
+double display_psnr(const std::vector<float>& a, const std::vector<float>& b) {
+    double se = 0;
+    for (std::size_t p = 0; p < a.size(); ++p) {
+        const double d = std::clamp(double(a[p]), 0.0, 1.0) - std::clamp(double(b[p]), 0.0, 1.0);
+        se += d * d;
+    }
+    return 10 * std::log10(double(a.size()) / std::max(se, 1e-30));
+}
+
+struct ExportedFile {
+    StrictPly ply;
+    int degree = 0;
+};
+
+ExportedFile export_and_read(const TempDir& tmp, const GaussianModel& model, const ShCoeffs<float>& env,
+                             BakeShading shading, int degree, const std::vector<Vec3d>& cameras) {
+    const std::string path = tmp / ("baked_" + std::to_string(degree) + ".ply");
+    const SurfelSides sides = bake_surfel_sides(model, env, shading);
+    write_3dgs_ply(path, model, two_sided_view_sh(model, sides, degree, cameras), degree);
+    return {read_strict_ply(path), degree};
+}
+
+TEST(ExportPly3dgs, StrictHeaderAndValuesForEveryDegree) {
     TempDir tmp("export_3dgs_strict");
-    const Camera cam = lumigauss::testing::test_camera();
-    const GaussianModel model = facing_model(cam, 3, 25);
-    const std::vector<float> colours = bake_surfel_colours(model, moderate_env(), BakeShading::Shadowed);
-    const std::string path = tmp / "model_3dgs.ply";
-    write_3dgs_ply(path, model, colours);
-    const StrictPly ply = read_strict_ply(path);
-    ASSERT_FALSE(::testing::Test::HasFailure());
-    EXPECT_EQ(ply.count, model.size());
-    EXPECT_EQ(ply.names, expected_properties());
-    EXPECT_EQ(ply_3dgs_property_names(), expected_properties());
-    const auto& xyz = model.param(ModelParam::Xyz);
-    const auto& op = model.param(ModelParam::Opacity);
-    const auto& sc = model.param(ModelParam::Scaling);
+    const GaussianModel model = cube_model(3, 25);
+    const ShCoeffs<float> env = moderate_env();
+    const SurfelSides sides = bake_surfel_sides(model, env, BakeShading::Shadowed);
+    const std::vector<Vec3d> above = {{0, 0, 50}};
+    for (int degree = 0; degree <= 3; ++degree) {
+        const ExportedFile file = export_and_read(tmp, model, env, BakeShading::Shadowed, degree, above);
+        const StrictPly& ply = file.ply;
+        ASSERT_FALSE(::testing::Test::HasFailure()) << "degree " << degree;
+        EXPECT_EQ(ply.count, model.size());
+        EXPECT_EQ(ply.names, expected_properties(degree));
+        EXPECT_EQ(ply_3dgs_property_names(degree), expected_properties(degree));
+        const auto& xyz = model.param(ModelParam::Xyz);
+        const auto& op = model.param(ModelParam::Opacity);
+        const auto& sc = model.param(ModelParam::Scaling);
+        for (std::size_t i = 0; i < model.size(); ++i) {
+            EXPECT_EQ(ply.at(i, "x"), xyz[3 * i]);
+            EXPECT_EQ(ply.at(i, "z"), xyz[3 * i + 2]);
+            EXPECT_EQ(ply.at(i, "opacity"), op[i]);
+            EXPECT_EQ(ply.at(i, "scale_0"), sc[2 * i]);
+            EXPECT_EQ(ply.at(i, "scale_1"), sc[2 * i + 1]);
+            EXPECT_NEAR(ply.at(i, "scale_2"), std::log(1e-6), 1e-5);
+            // Degree 0: the side the camera above sees; else the DC is the mean of the two sides.
+            const bool above_sees_positive = model.normal(i).z >= 0;
+            for (int c = 0; c < 3; ++c) {
+                const float pos = sides.positive[3 * i + std::size_t(c)];
+                const float neg = sides.negative[3 * i + std::size_t(c)];
+                const float expected = degree > 0 ? 0.5f * (pos + neg) : (above_sees_positive ? pos : neg);
+                EXPECT_NEAR(0.5 + 0.28209479177387814 * ply.at(i, "f_dc_" + std::to_string(c)), expected,
+                            1e-5);
+            }
+            double qn = 0, nn = 0;
+            for (int k = 0; k < 4; ++k) qn += std::pow(ply.at(i, "rot_" + std::to_string(k)), 2);
+            for (const char* n : {"nx", "ny", "nz"}) nn += std::pow(ply.at(i, n), 2);
+            EXPECT_NEAR(qn, 1.0, 1e-5);
+            EXPECT_NEAR(nn, 1.0, 1e-5);
+            EXPECT_GE(ply.at(i, "rot_0") * model.param(ModelParam::Rotation)[4 * i], 0.0f);  // same sign
+        }
+    }
+    EXPECT_THROW(two_sided_view_sh(model, sides, 4, above), Error);
+    EXPECT_THROW(write_3dgs_ply(tmp / "bad.ply", model, std::vector<float>(3), 0), Error);
+}
+
+// Seen straight on, the degree-3 file's colour of each surfel is that side's baked colour within the step
+// expansion's error at s = 1 (p(1) = 0.8: 0.2 of half the difference); seen from the other side, the other's.
+TEST(ExportPly3dgs, EachSideShowsItsOwnColour) {
+    TempDir tmp("export_3dgs_sides");
+    const GaussianModel model = cube_model(5, 40);
+    const ShCoeffs<float> env = moderate_env();
+    const SurfelSides sides = bake_surfel_sides(model, env, BakeShading::Shadowed);
+    const ExportedFile file = export_and_read(tmp, model, env, BakeShading::Shadowed, 3, {});
     for (std::size_t i = 0; i < model.size(); ++i) {
-        EXPECT_EQ(ply.at(i, "x"), xyz[3 * i]);
-        EXPECT_EQ(ply.at(i, "z"), xyz[3 * i + 2]);
-        EXPECT_EQ(ply.at(i, "opacity"), op[i]);
-        EXPECT_EQ(ply.at(i, "scale_0"), sc[2 * i]);
-        EXPECT_EQ(ply.at(i, "scale_1"), sc[2 * i + 1]);
-        EXPECT_NEAR(ply.at(i, "scale_2"), std::log(1e-6), 1e-5);
-        for (int c = 0; c < 3; ++c)
-            EXPECT_NEAR(0.5 + 0.28209479177387814 * ply.at(i, "f_dc_" + std::to_string(c)),
-                        colours[3 * i + std::size_t(c)], 1e-6);
-        for (int k = 0; k < 45; ++k) EXPECT_EQ(ply.at(i, "f_rest_" + std::to_string(k)), 0.0f);
-        double qn = 0, nn = 0;
-        for (int k = 0; k < 4; ++k) qn += std::pow(ply.at(i, "rot_" + std::to_string(k)), 2);
-        for (const char* n : {"nx", "ny", "nz"}) nn += std::pow(ply.at(i, n), 2);
-        EXPECT_NEAR(qn, 1.0, 1e-5);
-        EXPECT_NEAR(nn, 1.0, 1e-5);
-        EXPECT_GE(ply.at(i, "rot_0") * model.param(ModelParam::Rotation)[4 * i], 0.0f);  // same sign
+        const Vec3d n = model.normal(i).cast<double>();
+        const Vec3d front = inria_colour(file.ply, i, 3, -n), back = inria_colour(file.ply, i, 3, n);
+        for (int c = 0; c < 3; ++c) {
+            const double pos = sides.positive[3 * i + std::size_t(c)],
+                         neg = sides.negative[3 * i + std::size_t(c)];
+            const double half = 0.5 * (pos - neg);
+            EXPECT_NEAR(front[c], std::max(0.0, pos - 0.2 * half), 1e-4) << "surfel " << i;
+            EXPECT_NEAR(back[c], std::max(0.0, neg + 0.2 * half), 1e-4) << "surfel " << i;
+        }
     }
 }
 
-// Render-back: the exported 3DGS PLY through the 2DGS path equals the relightable render, max abs pixel
-// difference <= 1e-5 (float round trips of exp/log, sigmoid/logit and the f_dc encoding).
-void expect_render_back(BakeShading bake, ShadingMode mode) {
+// The whole point: from cameras all around, the baked file renders like the relightable model. The old
+// bake (one colour, the positive side: degree 0 without cameras) is shown to fail the same check.
+void expect_two_sided_render(BakeShading bake, ShadingMode mode) {
     TempDir tmp("export_3dgs_render");
-    const Camera cam = lumigauss::testing::test_camera(48, 40);
-    const GaussianModel model = facing_model(cam, 5);
+    const GaussianModel model = cube_model(7);
     const ShCoeffs<float> env = moderate_env();
-    const std::vector<float> colours = bake_surfel_colours(model, env, bake);
-    float top = 0;
-    for (float c : colours) top = std::max(top, c);
-    ASSERT_LT(top, 0.999f) << "the environment is too bright for an unclamped comparison";
+    const ExportedFile degree3 = export_and_read(tmp, model, env, bake, 3, {});
+    const ExportedFile degree1 = export_and_read(tmp, model, env, bake, 1, {});
+    const ExportedFile positive_only = export_and_read(tmp, model, env, bake, 0, {});
+    double worst3 = 1e9, worst1 = 1e9, worst_positive = 1e9;
+    for (const Camera& cam : ring_cameras()) {
+        const RasterImages<float> ref = render_with_environment(model, cam, env, mode);
+        double covered = 0;
+        for (float a : ref.alpha) covered += a;
+        ASSERT_GT(covered, 0.2 * double(ref.alpha.size())) << "the camera sees too little";
+        const auto psnr = [&](const ExportedFile& f) {
+            RasterState<float> state;
+            const RasterImages<float> back =
+                rasterize_forward_cpu(cam, splats_for_view(f.ply, f.degree, cam.center()), {}, state);
+            return display_psnr(back.color, ref.color);
+        };
+        worst3 = std::min(worst3, psnr(degree3));
+        worst1 = std::min(worst1, psnr(degree1));
+        worst_positive = std::min(worst_positive, psnr(positive_only));
+    }
+    std::printf("worst PSNR: degree 3 %.2f dB, degree 1 %.2f dB, one colour (+normal side) %.2f dB\n", worst3,
+                worst1, worst_positive);
+    EXPECT_GE(worst3, 30.0);
+    EXPECT_GE(worst1, 25.0);
+    EXPECT_GT(worst3, worst1);
+    EXPECT_LT(worst_positive, worst1 - 5.0) << "one colour per surfel should show the back sides wrong";
+}
 
-    // Every surfel shows its positive side.
-    ViewNormals normals;
-    compute_view_normals(model, cam, normals);
-    for (auto side : normals.positive_side) ASSERT_EQ(side, 1);
+TEST(ExportPly3dgs, RendersLikeTheModelFromBothSidesShadowed) {
+    expect_two_sided_render(BakeShading::Shadowed, ShadingMode::Shadowed);
+}
 
-    const std::string path = tmp / "baked.ply";
-    write_3dgs_ply(path, model, colours);
-    ViewDependentSurfels loaded = load_2dgs_ply(path);
-    ASSERT_EQ(loaded.size(), model.size());
-    EXPECT_EQ(loaded.sh_degree, 3);
-    colors_for_view(loaded, cam.center());
+TEST(ExportPly3dgs, RendersLikeTheModelFromBothSidesUnshadowed) {
+    expect_two_sided_render(BakeShading::Unshadowed, ShadingMode::Unshadowed);
+}
+
+// One colour per surfel (degree 0, .splat): the side the given cameras see, weighted by |cos|; for a single
+// camera that is exactly what it renders, so the file renders back to within float rounding.
+TEST(ExportPly3dgs, OneColourIsTheSideTheCamerasSee) {
+    TempDir tmp("export_3dgs_seen");
+    const GaussianModel model = cube_model(9);
+    const ShCoeffs<float> env = moderate_env();
+    const Camera cam = ring_cameras()[2];
+    const ExportedFile file = export_and_read(tmp, model, env, BakeShading::Shadowed, 0, {cam.center()});
     RasterState<float> state;
     const RasterImages<float> back =
-        rasterize_forward_cpu(cam, loaded.surfels, RasterSettings<float>{}, state);
-    const RasterImages<float> ref = render_with_environment(model, cam, env, mode);
-    ASSERT_EQ(back.color.size(), ref.color.size());
-    double max_diff = 0, sum = 0;
-    for (std::size_t p = 0; p < ref.color.size(); ++p) {
+        rasterize_forward_cpu(cam, splats_for_view(file.ply, 0, cam.center()), {}, state);
+    const RasterImages<float> ref = render_with_environment(model, cam, env, ShadingMode::Shadowed);
+    double max_diff = 0;
+    for (std::size_t p = 0; p < ref.color.size(); ++p)
         max_diff = std::max(max_diff, double(std::abs(back.color[p] - ref.color[p])));
-        sum += ref.color[p];
-    }
-    EXPECT_GT(sum, 10.0) << "nothing rendered";
     EXPECT_LE(max_diff, 1e-5);
+
+    // Two cameras on opposite sides of a surfel: the one seeing it more squarely wins.
+    const SurfelSides sides = bake_surfel_sides(model, env, BakeShading::Shadowed);
+    const Vec3d c0{model.param(ModelParam::Xyz)[0], model.param(ModelParam::Xyz)[1],
+                   model.param(ModelParam::Xyz)[2]};
+    const Vec3d n = model.normal(0).cast<double>();
+    const Vec3d side = normalize(cross(n, std::abs(n.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0}));
+    const std::vector<Vec3d> squarely_behind = {c0 + 3.0 * (n + 0.2 * side), c0 - 3.0 * n};
+    const std::vector<Vec3d> squarely_in_front = {c0 + 3.0 * n, c0 - 3.0 * (n + 2.0 * side)};
+    EXPECT_EQ(seen_side_colours(model, sides, squarely_behind)[0], sides.negative[0]);
+    EXPECT_EQ(seen_side_colours(model, sides, squarely_in_front)[0], sides.positive[0]);
+    EXPECT_EQ(seen_side_colours(model, sides, {})[0], sides.positive[0]);
 }
 
-TEST(ExportPly3dgs, RenderBackMatchesShadowedRender) {
-    expect_render_back(BakeShading::Shadowed, ShadingMode::Shadowed);
-}
-
-TEST(ExportPly3dgs, RenderBackMatchesUnshadowedRender) {
-    expect_render_back(BakeShading::Unshadowed, ShadingMode::Unshadowed);
-}
-
-TEST(ExportPly3dgs, BakeClampsToUnitRangeAndParsesShading) {
-    const Camera cam = lumigauss::testing::test_camera();
-    const GaussianModel model = facing_model(cam, 9, 30);
+TEST(ExportPly3dgs, BakedColoursAreNotClampedAndShadingParses) {
+    const GaussianModel model = cube_model(9, 30);
     ShCoeffs<float> hot = moderate_env();
     for (int k = 0; k < kShCount; ++k) hot.c[k] = hot.c[k] * 50.0f;
-    for (float c : bake_surfel_colours(model, hot, BakeShading::Unshadowed)) {
+    const SurfelSides sides = bake_surfel_sides(model, hot, BakeShading::Unshadowed);
+    float top = 0;
+    for (float c : sides.positive) {
         EXPECT_GE(c, 0.0f);
-        EXPECT_LE(c, 1.0f);
+        top = std::max(top, c);
     }
+    EXPECT_GT(top, 1.0f) << "a 3DGS renderer clamps the pixel, not the splat";
     EXPECT_EQ(parse_bake_shading("shadowed"), BakeShading::Shadowed);
     EXPECT_EQ(parse_bake_shading("unshadowed"), BakeShading::Unshadowed);
     EXPECT_THROW(parse_bake_shading("both"), Error);

@@ -59,7 +59,9 @@ TEST(ExportSplat, FileIsSortedRecords) {
     const Camera cam = lumigauss::testing::test_camera();
     const GaussianModel model = relight_test::random_model(cam, 17, 20);
     ShCoeffs<double> sh = relight_test::bright_sh(3);
-    const std::vector<float> colours = bake_surfel_colours(model, sh.cast<float>(), BakeShading::Shadowed);
+    const SurfelSides sides = bake_surfel_sides(model, sh.cast<float>(), BakeShading::Shadowed);
+    const std::vector<Vec3d> cameras = {cam.center()};
+    const std::vector<float> colours = seen_side_colours(model, sides, cameras);
     const std::vector<SplatRecord> records = splat_records(model, colours);
     ASSERT_EQ(records.size(), model.size());
     for (std::size_t i = 0; i < records.size(); ++i) {

@@ -96,6 +96,15 @@ TEST(RelightTrainedRun, SkyHorizonIsTheTrainingCamerasMeanUpWithTheConfigAngles)
     EXPECT_NEAR(h.up.x, 0, 1e-6);
     EXPECT_NEAR(h.up.y, -1, 1e-6);
     EXPECT_NEAR(h.up.z, 0, 1e-6);
+    // The training photos' camera centres (-R^T t), the held-out photo left out.
+    record.photos[1].translation = {1, 2, 3};
+    save_scene_record(run_paths(dir).scene, record);
+    const TrainedRun run = load_trained_run(dir);
+    ASSERT_EQ(run.photo_centres.size(), 2u);
+    EXPECT_EQ(length(run.photo_centres[0]), 0.0);
+    EXPECT_NEAR(run.photo_centres[1].x, -3, 1e-12);  // R^T t = (3, 2, -1)
+    EXPECT_NEAR(run.photo_centres[1].y, -2, 1e-12);
+    EXPECT_NEAR(run.photo_centres[1].z, 1, 1e-12);
     // A run trained without a fade has no horizon.
     {
         std::ofstream c(run_paths(dir).config);

@@ -16,20 +16,32 @@ namespace lumigauss {
 
 namespace {
 
-// The up of the training photos that scene.json records (camera_up_direction); none without the record or
-// when their rotations do not fix one.
-std::optional<Vec3d> recorded_photos_up(const std::string& dir) {
-    const std::optional<SceneRecord> scene = load_scene_record(run_paths(dir).scene);
-    if (!scene) return std::nullopt;
+// The world-to-camera rotations and camera centres of the training photos that scene.json records; empty
+// without the record.
+struct RecordedTrainingCameras {
     std::vector<Mat3d> rotations;
+    std::vector<Vec3d> centres;
+};
+RecordedTrainingCameras recorded_training_cameras(const std::string& dir) {
+    RecordedTrainingCameras cameras;
+    const std::optional<SceneRecord> scene = load_scene_record(run_paths(dir).scene);
+    if (!scene) return cameras;
     for (const RecordedPhoto& p : scene->photos) {
         if (p.split != "train") continue;
         Mat3d r;
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) r(i, j) = p.rotation[std::size_t(3 * i + j)];
-        rotations.push_back(r);
+        const Vec3d t{p.translation[0], p.translation[1], p.translation[2]};
+        cameras.rotations.push_back(r);
+        cameras.centres.push_back(-(transpose(r) * t));
     }
-    const Vec3d up = camera_up_direction(rotations);
+    return cameras;
+}
+
+// The up of those photos (camera_up_direction); none when there are none or their rotations fix none.
+std::optional<Vec3d> photos_up_of(const RecordedTrainingCameras& cameras) {
+    if (cameras.rotations.empty()) return std::nullopt;
+    const Vec3d up = camera_up_direction(cameras.rotations);
     if (!(length(up) > 0)) return std::nullopt;
     return up;
 }
@@ -92,7 +104,9 @@ TrainedRun load_trained_run(const std::string& dir) {
                                             run.paths.appearance + " lists " +
                                             std::to_string(run.image_names.size()));
     }
-    run.photos_up = recorded_photos_up(dir);
+    const RecordedTrainingCameras cameras = recorded_training_cameras(dir);
+    run.photos_up = photos_up_of(cameras);
+    run.photo_centres = cameras.centres;
     if (fs::exists(run.paths.config)) {
         const nlohmann::json c = nlohmann::json::parse(read_text_file(run.paths.config), nullptr, false);
         if (c.is_discarded()) fail_in_file(run.paths.config, "not valid JSON");

@@ -27,6 +27,9 @@ struct TrainedRun {
     // The world's up as the training photos that scene.json records give it (camera_up_direction); none
     // without the record (a bare PLY, a run of an older version).
     std::optional<Vec3d> photos_up;
+    // The centres of the cameras of those training photos (empty without the record): which side of each
+    // surfel the photos saw, for exports that hold one colour per surfel.
+    std::vector<Vec3d> photo_centres;
     // Where that sky ends below the horizon: config.json sky_horizon_start/fade, about photos_up (no horizon
     // without it, as the run was trained then).
     SkyHorizon sky_horizon;

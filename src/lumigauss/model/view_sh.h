@@ -10,12 +10,13 @@ inline constexpr int view_sh_coefficients(int degree) {
     return (degree + 1) * (degree + 1);
 }
 
-// `sh` holds coefficient k of channel c at sh[3 * k + c]; `dir` is the unit direction camera -> surfel.
+// The basis functions of degree <= `degree` at the unit direction `dir` (view_sh_coefficients(degree)
+// values). They are orthonormal on the sphere, so the addition theorem holds: sum over m of the degree-l
+// functions at a and at b is (2l + 1) / (4 pi) P_l(a . b).
 template <typename T>
-LG_HD inline Vec3<T> eval_view_sh(int degree, const T* sh, Vec3<T> dir) {
+LG_HD inline void view_sh_basis(int degree, Vec3<T> dir, T basis[16]) {
     const T c0 = T(0.28209479177387814), c1 = T(0.4886025119029199);
     const T x = dir.x, y = dir.y, z = dir.z;
-    T basis[16];
     basis[0] = c0;
     if (degree > 0) basis[1] = -c1 * y, basis[2] = c1 * z, basis[3] = -c1 * x;
     if (degree > 1) {
@@ -35,6 +36,13 @@ LG_HD inline Vec3<T> eval_view_sh(int degree, const T* sh, Vec3<T> dir) {
             basis[15] = T(-0.5900435899266435) * x * (xx - 3 * yy);
         }
     }
+}
+
+// `sh` holds coefficient k of channel c at sh[3 * k + c]; `dir` is the unit direction camera -> surfel.
+template <typename T>
+LG_HD inline Vec3<T> eval_view_sh(int degree, const T* sh, Vec3<T> dir) {
+    T basis[16];
+    view_sh_basis(degree, dir, basis);
     Vec3<T> out{};
     for (int k = 0; k < view_sh_coefficients(degree); ++k)
         for (int c = 0; c < 3; ++c) out[c] += basis[k] * sh[3 * k + c];
