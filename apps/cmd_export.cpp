@@ -7,6 +7,8 @@
 //                    (export/splat_format.h)
 //   ply-relightable  the relightable PLY plus FILE.environments.json (export/relightable_bundle.h)
 //   env              folder of per-photo SH text files and EXR previews (export/environment_files.h)
+//   html             one self-contained web page: the relighting viewer with the model and its lights inside
+//                    (viewer/standalone_page.h)
 // Everything is loaded and checked before anything is written.
 #include <tbb/global_control.h>
 
@@ -22,9 +24,13 @@
 #include "lumigauss/export/relightable_bundle.h"
 #include "lumigauss/export/splat_format.h"
 #include "lumigauss/export/two_sided_sh.h"
+#include "lumigauss/io/atomic_file.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_source.h"
 #include "lumigauss/util/error.h"
+#include "lumigauss/viewer/model_payload.h"
+#include "lumigauss/viewer/standalone_page.h"
+#include "viewer_scene.h"
 
 namespace lumigauss::cli {
 namespace {
@@ -60,8 +66,9 @@ void run_export(const ExportOptions& o) {
     if (o.threads > 0)
         threads =
             std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, o.threads);
-    if (o.format != "ply-3dgs" && o.format != "splat" && o.format != "ply-relightable" && o.format != "env")
-        throw Error("--format '" + o.format + "': use ply-3dgs, splat, ply-relightable or env");
+    if (o.format != "ply-3dgs" && o.format != "splat" && o.format != "ply-relightable" && o.format != "env" &&
+        o.format != "html")
+        throw Error("--format '" + o.format + "': use ply-3dgs, splat, ply-relightable, env or html");
     if (o.source.empty() == o.ply.empty())
         throw Error("export: give either a training run folder (or relightable .ply) or --ply FILE");
     const std::string source = o.source.empty() ? o.ply : o.source;
@@ -69,8 +76,8 @@ void run_export(const ExportOptions& o) {
     if (o.out.empty()) throw Error("export: -o FILE is required");
     const bool baked = baked_format(o.format);
     if (baked && o.light.empty()) throw Error("--format " + o.format + " bakes colours: give --light");
-    if (!baked && !o.light.empty())
-        throw Error("--light is for the baked formats (ply-3dgs, splat), not " + o.format);
+    if (!baked && o.format != "html" && !o.light.empty())
+        throw Error("--light is for the baked formats (ply-3dgs, splat) and html, not " + o.format);
     const BakeShading shading = parse_bake_shading(o.shading);
     if (o.sh_degree_given && o.format != "ply-3dgs")
         throw Error("--sh-degree is for --format ply-3dgs (" + o.format + " holds no view-dependent colour)");
@@ -108,6 +115,20 @@ void run_export(const ExportOptions& o) {
                         o.out.c_str(), o.format.c_str());
         return;
     }
+    if (o.format == "html") {
+        ViewerSceneOptions scene_options{source, "", "", o.up, {}};
+        if (!o.light.empty()) scene_options.lights.push_back(o.light);
+        const view::ViewerScene scene = viewer_scene_for(run, scene_options);
+        const std::string page =
+            view::standalone_viewer_page(view::encode_model_payload(run.model), view::scene_json(scene));
+        make_parent(o.out);
+        write_file_atomically(o.out, page);
+        if (!o.quiet)
+            std::printf(
+                "export: %zu surfels and %zu lights in one page, %s (%.1f MB): open it in a browser\n",
+                run.model.size(), scene.lights.size(), o.out.c_str(), double(page.size()) / 1e6);
+        return;
+    }
     if (o.format == "ply-relightable") {
         make_parent(o.out);
         const std::string sidecar = write_relightable_bundle(o.out, run, up);
@@ -129,20 +150,21 @@ void register_export(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "export",
         "Export a trained run (or a relightable .ply of the official LumiGauss code) as a baked 3DGS PLY, a "
-        ".splat, a relightable PLY with its environments, or the environments alone (docs/formats.md)");
+        ".splat, a relightable PLY with its environments, the environments alone, or one self-contained web "
+        "page that relights the model in any browser (docs/formats.md)");
     cmd->add_option("source", o->source,
                     "training run folder (model.ply, lighting.lgmlp, appearance.json) or a relightable .ply");
     cmd->add_option("--ply", o->ply,
                     "a bare relightable PLY (official LumiGauss layout) instead of a run: no learned lights, "
                     "use --light with an SH .txt or a panorama");
-    cmd->add_option("--format", o->format, "ply-3dgs, splat, ply-relightable or env")->required();
+    cmd->add_option("--format", o->format, "ply-3dgs, splat, ply-relightable, env or html")->required();
     cmd->add_option("-o,--output", o->out,
-                    "output file (ply-3dgs, splat, ply-relightable: FILE.ply + FILE.environments.json) or "
-                    "folder (env)")
+                    "output file (ply-3dgs, splat, html; ply-relightable: FILE.ply + FILE.environments.json) "
+                    "or folder (env)")
         ->required();
     cmd->add_option("--light", o->light,
                     "ply-3dgs/splat: the lighting to bake, as for `render --light` (training photo, SH .txt, "
-                    "panorama; prefixes photo:, sh:, pano:)");
+                    "panorama; prefixes photo:, sh:, pano:); html: one more lighting, offered first");
     cmd->add_option("--shading", o->shading,
                     "baked colour: shadowed (the full model: transfer sets) or unshadowed (the normals)")
         ->capture_default_str();

@@ -4,23 +4,17 @@
 // file, environment rotation, shadowed/unshadowed/albedo/normals/shadow views (src/lumigauss/viewer/).
 #include <csignal>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
-#include <optional>
 
 #include "commands.h"
-#include "lumigauss/cameras/camera_json.h"
 #include "lumigauss/cameras/up_axis.h"
-#include "lumigauss/io/dataset.h"
-#include "lumigauss/model/run_files.h"
-#include "lumigauss/model/scene_record.h"
 #include "lumigauss/model/trained_run.h"
-#include "lumigauss/relight/light_source.h"
 #include "lumigauss/util/error.h"
 #include "lumigauss/viewer/http_server.h"
 #include "lumigauss/viewer/model_payload.h"
 #include "lumigauss/viewer/scene_info.h"
 #include "lumigauss/viewer/viewer_site.h"
+#include "viewer_scene.h"
 
 namespace lumigauss::cli {
 namespace {
@@ -64,50 +58,9 @@ class StopSignals {
     struct sigaction old_term_ = {};
 };
 
-// --scene, else the scene the run recorded (RUN/scene.json) if it is still there, else none: the viewer
-// works without one.
-std::string scene_to_open(const ViewOptions& o) {
-    if (!o.scene.empty()) return o.scene;
-    const std::optional<SceneRecord> record = load_scene_record(run_paths(o.source).scene);
-    std::error_code ec;
-    if (!record || !std::filesystem::is_directory(record->scene, ec)) return {};
-    return record->scene;
-}
-
-// The cameras "auto" estimates the up axis from, the initial one first: --camera (its first entry) wins over
-// the scene (its first training view).
-std::vector<Camera> known_cameras(const ViewOptions& o) {
-    std::vector<Camera> cams;
-    if (!o.camera_json.empty())
-        for (const NamedCamera& c : read_camera_json(o.camera_json)) cams.push_back(c.camera);
-    if (const std::string dir = scene_to_open(o); !dir.empty()) {
-        const Dataset scene = load_scene_of_run(o.source, dir);
-        const std::vector<const View*> train = scene.split(Split::Train);
-        if (!train.empty()) cams.push_back(train.front()->camera);
-        for (const View& v : scene.views) cams.push_back(v.camera);
-    }
-    return cams;
-}
-
-// --up, or for "auto" the up of the known cameras, else of the training photos the run recorded, else +z
-// (a bare PLY).
-Vec3d resolve_up(const ViewOptions& o, const std::vector<Camera>& cams, const TrainedRun& run) {
-    if (o.up != "auto") return parse_up_axis(o.up);
-    if (!cams.empty()) return estimate_up_axis(cams);
-    return run.photos_up.value_or(Vec3d{0, 0, 1});
-}
-
 void run_view(const ViewOptions& o) {
     const TrainedRun run = load_run_or_ply(o.source);
-    const std::vector<Camera> cams = known_cameras(o);
-    const Vec3d up = resolve_up(o, cams, run);
-    PanoramaOptions popt;
-    popt.frame = panorama_frame_for_up(up);
-    std::vector<ResolvedLight> lights;
-    for (const std::string& spec : o.lights) lights.push_back(resolve_light(spec, run, popt));
-    std::optional<Camera> initial;
-    if (!cams.empty()) initial = cams.front();
-    const view::ViewerScene scene = view::describe_scene(run, lights, up, initial);
+    const view::ViewerScene scene = viewer_scene_for(run, {o.source, o.scene, o.camera_json, o.up, o.lights});
 
     view::HttpServer* server_ptr = nullptr;
     view::ViewerSiteOptions site_options;
@@ -125,7 +78,7 @@ void run_view(const ViewOptions& o) {
     StopSignals signals(server);
     if (!o.quiet)
         std::printf("view: %zu surfels, %zu lights, up %s\n", run.model.size(), scene.lights.size(),
-                    up_axis_name(up).c_str());
+                    up_axis_name(scene.up).c_str());
     std::printf("view: open http://127.0.0.1:%d/ (Ctrl-C to stop)\n", server.port());
     std::fflush(stdout);
     server.run();

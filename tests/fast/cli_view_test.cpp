@@ -33,6 +33,8 @@
 #include "lumigauss/relight/relit_render.h"
 #include "lumigauss/render/raster_maps.h"
 #include "lumigauss/shading/sh_text.h"
+#include "lumigauss/viewer/http_server.h"
+#include "lumigauss/viewer/url_path.h"
 #include "relight_test_util.h"
 #include "support/random_surfels.h"
 #include "support/run_cli.h"
@@ -393,6 +395,77 @@ TEST(CliViewBrowser, RendersWithoutErrorsAndMatchesTheCppRenderer) {
     expect_shots_match(
         tmp, cam, rotate, r,
         {{"shadowed", 40}, {"unshadowed", 40}, {"albedo", 40}, {"normals", 30}, {"shadow", 40}});
+}
+
+// `export --format html`: the page with the model inside, in headless Chromium with nothing else: served
+// here as a single file by a bare server that knows no viewer routes (only the page and the bench report),
+// so the scene, the model, the modules and the sorting worker can only come from the page itself. No
+// errors, the worker (started from a blob) sorted, and the views from a fixed camera are the C++ renderer's.
+// (Opened from disk the page works the same; headless Chromium's --dump-dom cannot be made to wait for a
+// report reliably, so the test serves it. The page puts its report into #lg-report when opened from disk.)
+TEST(CliViewBrowser, ExportedPageWorksAlone) {
+    const std::optional<std::string> chromium = find_chromium();
+    if (!chromium)
+        GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/setup.sh does)";
+    TempDir tmp("cli_view_page");
+    const Camera cam = testing::test_camera(96, 72);
+    write_model_and_light(tmp, cam, 400);
+    const auto exported = testing::run_lumigauss(
+        "export --ply " + testing::shell_quoted(tmp / "model.ply") + " --format html --light " +
+            testing::shell_quoted(tmp / "env.txt") + " -o " + testing::shell_quoted(tmp / "page.html"),
+        tmp);
+    ASSERT_EQ(exported.exit_code, 0) << exported.output;
+    EXPECT_NE(exported.output.find("400 surfels and 2 lights in one page"), std::string::npos)
+        << exported.output;
+
+    const auto page = std::make_shared<const std::string>(read_text(tmp / "page.html"));
+    std::optional<std::string> report;
+    std::vector<std::string> other_requests;
+    view::HttpServer* server_ptr = nullptr;
+    view::HttpServerOptions options;
+    options.max_request_bytes = 8u << 20;  // the report rides in the query string
+    view::HttpServer server(options, [&](const view::HttpRequest& request) {
+        const auto target = view::parse_request_target(request.target);
+        if (target && target->path == "page.html") {
+            view::HttpResponse r;
+            r.content_type = "text/html; charset=utf-8";
+            r.body = *page;
+            r.owner = page;
+            return r;
+        }
+        if (target && target->path == "bench-report" && !report) {
+            const auto query = view::parse_query(target->query);
+            if (query && query->count("data")) report = query->at("data");
+            server_ptr->stop();
+            return view::HttpResponse::text(200, "ok");
+        }
+        other_requests.push_back(request.target);
+        return view::HttpResponse::text(404, "not here");
+    });
+    server_ptr = &server;
+    std::thread serving([&server] { server.run(); });
+    const pid_t browser = spawn(
+        {*chromium, "--headless=new", "--no-sandbox", "--use-angle=swiftshader",
+         "--enable-unsafe-swiftshader", "--user-data-dir=" + tmp / "profile", "--window-size=640,480",
+         "--force-device-scale-factor=1", "--no-first-run", "--no-default-browser-check",
+         "--disable-extensions", "--disable-background-networking", "--disable-dev-shm-usage", "--mute-audio",
+         "http://127.0.0.1:" + std::to_string(server.port()) + "/page.html?bench=2&cam=" + camera_param(cam)},
+        tmp / "browser.txt", true);
+    const auto end = Clock::now() + std::chrono::seconds(60);
+    while (browser > 0 && !report && Clock::now() < end)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    server.stop();
+    serving.join();
+    if (browser > 0) end_child(browser, true);
+    ASSERT_TRUE(report) << "no report from the page\n" << read_text(tmp / "browser.txt");
+    for (const std::string& t : other_requests)
+        EXPECT_TRUE(t.rfind("/favicon.ico", 0) == 0) << "the page asked the server for " << t;
+    const nlohmann::json r = nlohmann::json::parse(*report);
+    EXPECT_TRUE(r["errors"].empty()) << r["errors"].dump(2);
+    ASSERT_FALSE(r.value("failed", false)) << r.dump(2);
+    EXPECT_EQ(r["splats"], 400);
+    EXPECT_GT(r["sort_ms"]["count"].get<int>(), 0) << "the worker sorted nothing";
+    expect_shots_match(tmp, cam, 0, r, {{"shadowed", 40}, {"unshadowed", 40}, {"albedo", 40}});
 }
 
 TEST(CliViewBrowser, EightBitFallbackRendersTheColourViews) {

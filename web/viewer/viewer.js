@@ -1,5 +1,6 @@
-// The viewer page: loads scene.json and model.bin from the server (src/lumigauss/view/), renders with
-// renderer.js, sorts in sort_worker.js, and wires the controls. With ?bench=N (tests, bench/viewer_bench.sh)
+// The viewer page: loads scene.json and model.bin from the server (src/lumigauss/view/), or from the page
+// itself when `lumigauss export --format html` put them there (window.__lgEmbedded, viewer/standalone_page.h),
+// renders with renderer.js, sorts in sort_worker.js, and wires the controls. With ?bench=N (tests, bench/viewer_bench.sh)
 // it renders N frames while orbiting and reports frame-time statistics to the server instead; with
 // &cam=W,H,fx,fy,cx,cy,R(9),t(3) it first renders every view from that fixed camera and reports the pixels,
 // &rot=DEG turns the environment, &mode=VIEW picks the view of the orbit frames, &controls first drives every
@@ -17,7 +18,7 @@ const $ = (id) => document.getElementById(id);
 // one. `sorted(view)` resolves once a sort for that view (or a later one) has been applied.
 class DepthSorter {
   constructor(positions, onSorted) {
-    this.worker = new Worker('sort_worker.js');
+    this.worker = new Worker(sortWorkerUrl());
     this.worker.onerror = (e) => window.__lgError(`sort worker: ${e.message}`);
     this.worker.onmessage = (e) => this.received(e.data);
     this.worker.postMessage({ type: 'init', positions: positions.slice() });
@@ -56,6 +57,30 @@ class DepthSorter {
       this.queued = null;
     }
   }
+}
+
+// The worker's script: the served file, or for a page with everything inside, its text as a blob.
+function sortWorkerUrl() {
+  const embedded = window.__lgEmbedded;
+  if (!embedded) return 'sort_worker.js';
+  return URL.createObjectURL(new Blob([embedded.sortWorker], { type: 'text/javascript' }));
+}
+
+function decodeBase64(text) {
+  const binary = atob(text);
+  const bytes = new Uint8Array(binary.length);
+  for (let i = 0; i < binary.length; ++i) bytes[i] = binary.charCodeAt(i);
+  return bytes.buffer;
+}
+
+// scene.json and model.bin: from the server, or from the page itself.
+async function loadSceneAndModel() {
+  const embedded = window.__lgEmbedded;
+  if (embedded) return [embedded.scene, decodeBase64(embedded.model)];
+  return Promise.all([
+    fetchOk('scene.json').then((r) => r.json()),
+    fetchOk('model.bin').then((r) => r.arrayBuffer()),
+  ]);
 }
 
 async function fetchOk(url) {
@@ -361,10 +386,7 @@ class Viewer {
 
 async function main() {
   const params = new URLSearchParams(location.search);
-  const [scene, buffer] = await Promise.all([
-    fetchOk('scene.json').then((r) => r.json()),
-    fetchOk('model.bin').then((r) => r.arrayBuffer()),
-  ]);
+  const [scene, buffer] = await loadSceneAndModel();
   const viewer = new Viewer(scene, decodePayload(buffer));
   if (params.has('bench')) await viewer.bench(params);
   else viewer.start();
