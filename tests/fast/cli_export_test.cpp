@@ -110,6 +110,16 @@ TEST(CliExport, EveryFormatAndImportFromBarePly) {
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(fs::file_size(tmp / "m.splat"), 32 * surfels);
 
+    // html: one page holding the viewer, the model (base64) and the run's lights (the browser test opens
+    // one).
+    r = run_lumigauss(
+        "export " + shell_quoted(t.run) + " --format html -o " + shell_quoted(tmp / "page.html"), tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const std::string page = synth_test::read_bytes(tmp / "page.html");
+    EXPECT_NE(page.find("window.__lgEmbedded"), std::string::npos);
+    EXPECT_NE(page.find(photos[0]), std::string::npos) << "the learned lights are offered by photo name";
+    EXPECT_GT(page.size(), 124 * surfels * 4 / 3) << "the model payload is missing";
+
     // ply-relightable + sidecar; -q prints nothing. The sidecar's up is the training photos' (the synthetic
     // scene is z-up), not the +z default a bare PLY gets.
     r = run_lumigauss(
