@@ -1,5 +1,6 @@
 // `lumigauss view SOURCE [--port P] [--light L ...]`: serves the real-time relighting viewer (web/viewer/,
-// embedded in the binary) for a trained run or a bare relightable PLY on http://127.0.0.1:P/ until Ctrl-C.
+// embedded in the binary) for a trained run or a bare relightable PLY on http://127.0.0.1:P/ until Ctrl-C,
+// following the newer snapshots of a run that is still training (model_reloader.h).
 // The page renders in WebGL2: orbit camera, environment from the training photos' learned lightings or an SH
 // file, environment rotation, shadowed/unshadowed/albedo/normals/shadow views (src/lumigauss/viewer/).
 #include <csignal>
@@ -14,6 +15,7 @@
 #include "lumigauss/viewer/model_payload.h"
 #include "lumigauss/viewer/scene_info.h"
 #include "lumigauss/viewer/viewer_site.h"
+#include "model_reloader.h"
 #include "viewer_scene.h"
 
 namespace lumigauss::cli {
@@ -59,8 +61,9 @@ class StopSignals {
 };
 
 void run_view(const ViewOptions& o) {
+    const ViewerSceneOptions scene_options{o.source, o.scene, o.camera_json, o.up, o.lights};
     const TrainedRun run = load_run_or_ply(o.source);
-    const view::ViewerScene scene = viewer_scene_for(run, {o.source, o.scene, o.camera_json, o.up, o.lights});
+    const view::ViewerScene scene = viewer_scene_for(run, scene_options);
 
     view::HttpServer* server_ptr = nullptr;
     view::ViewerSiteOptions site_options;
@@ -76,6 +79,18 @@ void run_view(const ViewOptions& o) {
     view::HttpServer server(server_options, [&site](const view::HttpRequest& r) { return site.handle(r); });
     server_ptr = &server;
     StopSignals signals(server);
+    // A running training run writes a newer snapshot with every checkpoint: the page follows it.
+    const ModelReloader reloader(
+        run.paths, site,
+        [&scene_options] {
+            const TrainedRun newer = load_run_or_ply(scene_options.source);
+            return std::pair{view::encode_model_payload(newer.model),
+                             view::scene_json(viewer_scene_for(newer, scene_options))};
+        },
+        [&o](const std::string& line) {
+            if (!o.quiet) std::printf("view: %s\n", line.c_str());
+            std::fflush(stdout);
+        });
     if (!o.quiet)
         std::printf("view: %zu surfels, %zu lights, up %s\n", run.model.size(), scene.lights.size(),
                     up_axis_name(scene.up).c_str());

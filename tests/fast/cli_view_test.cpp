@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -30,11 +31,16 @@
 #include "lumigauss/cameras/camera_json.h"
 #include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/model/relightable_ply.h"
+#include "lumigauss/model/trained_run.h"
+#include "lumigauss/relight/light_source.h"
 #include "lumigauss/relight/relit_render.h"
 #include "lumigauss/render/raster_maps.h"
 #include "lumigauss/shading/sh_text.h"
 #include "lumigauss/viewer/http_server.h"
+#include "lumigauss/viewer/model_payload.h"
+#include "lumigauss/viewer/scene_info.h"
 #include "lumigauss/viewer/url_path.h"
+#include "lumigauss/viewer/viewer_site.h"
 #include "relight_test_util.h"
 #include "support/random_surfels.h"
 #include "support/run_cli.h"
@@ -163,6 +169,52 @@ TEST(CliView, PrintsItsUrlServesThePageAndStopsOnCtrlC) {
     ASSERT_TRUE(code) << "Ctrl-C did not stop the server";
     EXPECT_EQ(*code, 0);
     EXPECT_NE(read_text(tmp / "log.txt").find("view: stopped"), std::string::npos);
+}
+
+// A running training writes a newer snapshot with every checkpoint: `view` serves it (GET /version grows,
+// model.bin is the new model) and keeps the current one when a snapshot cannot be loaded.
+TEST(CliView, FollowsANewerSnapshotOfTheModel) {
+    TempDir tmp("cli_view_reload");
+    write_model_and_light(tmp, testing::test_camera(), 40);
+    const pid_t pid =
+        spawn({LUMIGAUSS_BINARY, "view", tmp / "model.ply", "--port", "0"}, tmp / "log.txt", false);
+    ASSERT_GT(pid, 0);
+    const std::optional<int> port = wait_for_port(tmp / "log.txt", 20);
+    if (!port) end_child(pid, false);
+    ASSERT_TRUE(port) << read_text(tmp / "log.txt");
+    const auto version = [&] { return nlohmann::json::parse(http_get(*port, "/version").second)["version"]; };
+    const auto wait_for_version = [&](int want) {
+        const auto end = Clock::now() + std::chrono::seconds(15);
+        while (version() != want && Clock::now() < end)
+            std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        return version() == want;
+    };
+    EXPECT_EQ(version(), 1);
+    EXPECT_EQ(http_get(*port, "/model.bin").second.size(), 32u + 124u * 40u);
+
+    // A newer snapshot, written as training writes it (to a temporary name, then renamed).
+    save_relightable_ply(tmp / "newer.ply", relight_test::random_model(testing::test_camera(), 5, 25));
+    std::filesystem::rename(tmp / "newer.ply", tmp / "model.ply");
+    EXPECT_TRUE(wait_for_version(2)) << read_text(tmp / "log.txt");
+    EXPECT_EQ(http_get(*port, "/model.bin").second.size(), 32u + 124u * 25u);
+
+    // A damaged one: reported, the current model stays.
+    {
+        std::ofstream bad(tmp / "model.ply", std::ios::trunc);
+        bad << "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n";
+    }
+    const auto end = Clock::now() + std::chrono::seconds(15);
+    while (read_text(tmp / "log.txt").find("could not reload") == std::string::npos && Clock::now() < end)
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    EXPECT_NE(read_text(tmp / "log.txt").find("could not reload"), std::string::npos)
+        << read_text(tmp / "log.txt");
+    EXPECT_EQ(version(), 2);
+    EXPECT_EQ(http_get(*port, "/model.bin").second.size(), 32u + 124u * 25u);
+    ::kill(pid, SIGINT);
+    const std::optional<int> code = wait_for_exit(pid, 10);
+    if (!code) end_child(pid, false);
+    ASSERT_TRUE(code) << "Ctrl-C did not stop the server";
+    EXPECT_EQ(*code, 0);
 }
 
 TEST(CliView, InitialCameraAndUpAxisFromACameraJson) {
@@ -466,6 +518,73 @@ TEST(CliViewBrowser, ExportedPageWorksAlone) {
     EXPECT_EQ(r["splats"], 400);
     EXPECT_GT(r["sort_ms"]["count"].get<int>(), 0) << "the worker sorted nothing";
     expect_shots_match(tmp, cam, 0, r, {{"shadowed", 40}, {"unshadowed", 40}, {"albedo", 40}});
+}
+
+// The page follows a newer model: served by the viewer's own site in this process, which is handed a
+// second model once the page has fetched the first; the page (bench mode, &reload=300) polls /version,
+// reloads, and renders the new model like the C++ renderer.
+TEST(CliViewBrowser, PageReloadsANewerModel) {
+    const std::optional<std::string> chromium = find_chromium();
+    if (!chromium)
+        GTEST_SKIP() << "chromium is not installed (apt-get install chromium; scripts/setup.sh does)";
+    TempDir tmp("cli_view_page_reload");
+    const Camera cam = testing::test_camera(96, 72);
+    write_model_and_light(tmp, cam, 400);
+    const auto scene_of = [&](const std::string& ply) {
+        const TrainedRun run = load_run_or_ply(ply);
+        const ResolvedLight light = resolve_light(tmp / "env.txt", run, PanoramaOptions{});
+        return view::scene_json(view::describe_scene(run, {light}, {0, 0, 1}, std::nullopt));
+    };
+    view::ViewerSite site(view::encode_model_payload(load_relightable_ply(tmp / "model.ply")),
+                          scene_of(tmp / "model.ply"), {});
+    // The newer model replaces model.ply, which expect_shots_match renders.
+    save_relightable_ply(tmp / "model.ply", relight_test::random_model(cam, 33, 300));
+    std::atomic<bool> fetched{false};
+    std::optional<std::string> report;
+    view::HttpServer* server_ptr = nullptr;
+    view::HttpServerOptions options;
+    options.max_request_bytes = 8u << 20;
+    view::HttpServer server(options, [&](const view::HttpRequest& request) {
+        const auto target = view::parse_request_target(request.target);
+        if (target && target->path == "bench-report") {
+            const auto query = view::parse_query(target->query);
+            if (query && query->count("data") && !report) report = query->at("data");
+            server_ptr->stop();
+            return view::HttpResponse::text(200, "ok");
+        }
+        if (target && target->path == "model.bin") fetched = true;
+        return site.handle(request);
+    });
+    server_ptr = &server;
+    std::thread serving([&server] { server.run(); });
+    const pid_t browser = spawn(
+        {*chromium, "--headless=new", "--no-sandbox", "--use-angle=swiftshader",
+         "--enable-unsafe-swiftshader", "--user-data-dir=" + tmp / "profile", "--window-size=640,480",
+         "--force-device-scale-factor=1", "--no-first-run", "--no-default-browser-check",
+         "--disable-extensions", "--disable-background-networking", "--disable-dev-shm-usage", "--mute-audio",
+         "http://127.0.0.1:" + std::to_string(server.port()) +
+             "/?bench=1&reload=300&cam=" + camera_param(cam)},
+        tmp / "browser.txt", true);
+    auto end = Clock::now() + std::chrono::seconds(60);
+    while (browser > 0 && !fetched && Clock::now() < end)
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (fetched)
+        site.replace(view::encode_model_payload(load_relightable_ply(tmp / "model.ply")),
+                     scene_of(tmp / "model.ply"));
+    end = Clock::now() + std::chrono::seconds(60);
+    while (browser > 0 && !report && Clock::now() < end)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    server.stop();
+    serving.join();
+    if (browser > 0) end_child(browser, true);
+    ASSERT_TRUE(fetched) << "the page never fetched the model\n" << read_text(tmp / "browser.txt");
+    ASSERT_TRUE(report) << "no report from the page\n" << read_text(tmp / "browser.txt");
+    const nlohmann::json r = nlohmann::json::parse(*report);
+    EXPECT_TRUE(r["errors"].empty()) << r["errors"].dump(2);
+    EXPECT_EQ(r["splats"], 300);
+    EXPECT_EQ(r["reloads"], 1);
+    EXPECT_EQ(r["version"], 2);
+    expect_shots_match(tmp, cam, 0, r, {{"shadowed", 40}, {"albedo", 40}});
 }
 
 TEST(CliViewBrowser, EightBitFallbackRendersTheColourViews) {

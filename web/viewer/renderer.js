@@ -52,9 +52,17 @@ export class SplatRenderer {
     this.target = null;
   }
 
-  // packed: model.js packSplats().
+  // packed: model.js packSplats(). Called again for a newer model (a running training's snapshot): the
+  // previous model's textures and index buffer are freed first.
   setModel(packed) {
     const gl = this.gl;
+    if (this.texture) {
+      gl.deleteTexture(this.texture);
+      gl.deleteBuffer(this.indexBuffer);
+      gl.deleteTexture(this.orderTexture);  // immutable storage (texStorage2D): a new size needs a new one
+      this.orderTexture = gl.createTexture();
+      this.instances = 0;
+    }
     this.texture = gl.createTexture();
     gl.bindTexture(gl.TEXTURE_2D, this.texture);
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
@@ -67,7 +75,8 @@ export class SplatRenderer {
     const indices = new Uint32Array(6 * quads);
     for (let q = 0; q < quads; ++q) indices.set([4 * q, 4 * q + 1, 4 * q + 2, 4 * q + 1, 4 * q + 3, 4 * q + 2], 6 * q);
     gl.bindVertexArray(this.splatVao);
-    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, gl.createBuffer());
+    this.indexBuffer = gl.createBuffer();
+    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, this.indexBuffer);
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, indices, gl.STATIC_DRAW);
     gl.bindVertexArray(null);
     this.orderRows = Math.max(1, Math.ceil(packed.count / ORDER_WIDTH));

@@ -73,14 +73,24 @@ function decodeBase64(text) {
   return bytes.buffer;
 }
 
-// scene.json and model.bin: from the server, or from the page itself.
+// The version of the model the server serves (it grows with each newer snapshot of a running training).
+async function serverVersion() {
+  const r = await fetch('version', { cache: 'no-store' });
+  if (!r.ok) throw new Error(`version: HTTP ${r.status}`);
+  return (await r.json()).version;
+}
+
+// scene.json and model.bin (and the version they belong to, read first: a newer one seen later reloads),
+// from the server, or from the page itself (version 0, never reloaded).
 async function loadSceneAndModel() {
   const embedded = window.__lgEmbedded;
-  if (embedded) return [embedded.scene, decodeBase64(embedded.model)];
-  return Promise.all([
+  if (embedded) return [embedded.scene, decodeBase64(embedded.model), 0];
+  const version = await serverVersion();
+  const [scene, buffer] = await Promise.all([
     fetchOk('scene.json').then((r) => r.json()),
     fetchOk('model.bin').then((r) => r.arrayBuffer()),
   ]);
+  return [scene, buffer, version];
 }
 
 async function fetchOk(url) {
@@ -109,8 +119,10 @@ function base64(bytes) {
 }
 
 class Viewer {
-  constructor(scene, model) {
+  constructor(scene, model, version) {
     this.scene = scene;
+    this.version = version;
+    this.reloads = 0;
     this.lights = scene.lights.map((l) => ({ name: l.name, kind: l.kind, sh: l.sh }));
     this.lightIndex = scene.initial_light || 0;
     this.rotation = 0;
@@ -138,6 +150,52 @@ class Viewer {
     this.dirty = true;
   }
 
+  // A newer model from the server (a running training's snapshot): the view, the controls and the chosen
+  // light (by name) stay as they are.
+  replaceModel(scene, model, version) {
+    const lightName = this.lights[this.lightIndex].name;
+    const added = this.lights.filter((l) => l.kind === 'SH file');  // loaded in this page: keep them
+    this.scene = Object.assign(scene, { up: this.scene.up, e1: this.scene.e1, e2: this.scene.e2 });
+    this.lights = scene.lights.map((l) => ({ name: l.name, kind: l.kind, sh: l.sh })).concat(added);
+    const same = this.lights.findIndex((l) => l.name === lightName);
+    this.lightIndex = same >= 0 ? same : scene.initial_light || 0;
+    this.renderer.setModel(packSplats(model, this.renderer.maxTextureSize));
+    this.sorter.worker.terminate();
+    this.sorter = new DepthSorter(model.xyz, (indices, count) => {
+      this.renderer.setOrder(indices, count);
+      this.dirty = true;
+    });
+    this.count = model.count;
+    this.version = version;
+    this.reloads += 1;
+    this.needsSort = true;
+    if ($('light').options.length) this.fillLightMenu();
+    this.updateEnvironment();
+  }
+
+  // Polls the server's model version every `ms` and reloads when it grows.
+  watchServer(ms) {
+    let busy = false;
+    setInterval(async () => {
+      if (busy) return;
+      busy = true;
+      try {
+        const version = await serverVersion();
+        if (version > this.version) {
+          const [scene, buffer] = await Promise.all([
+            fetchOk('scene.json').then((r) => r.json()),
+            fetchOk('model.bin').then((r) => r.arrayBuffer()),
+          ]);
+          this.replaceModel(scene, decodePayload(buffer), version);
+          $('message').textContent = '';
+        }
+      } catch (err) {
+        $('message').textContent = `reloading the model: ${err.message}`;  // the server may be gone
+      }
+      busy = false;
+    }, ms);
+  }
+
   canvasSize() {
     const c = this.renderer.canvas, dpr = window.devicePixelRatio || 1;
     return [Math.max(1, Math.round(c.clientWidth * dpr)), Math.max(1, Math.round(c.clientHeight * dpr))];
@@ -157,7 +215,8 @@ class Viewer {
       const [w, h] = this.canvasSize();
       const view = this.camera.view(w, h);
       const key = JSON.stringify([view.R, view.t]);
-      if (key !== lastKey) {
+      if (key !== lastKey || this.needsSort) {
+        this.needsSort = false;
         this.sorter.request(view);
         lastKey = key;
         this.dirty = true;
@@ -356,9 +415,16 @@ class Viewer {
   }
 
   async bench(params) {
+    // &reload=N: first wait (30 s at most) for the server to serve a model of N splats, polling often.
+    if (params.has('reload')) {
+      const want = Number(params.get('reload'));
+      this.watchServer(100);
+      const until = performance.now() + 30000;
+      while (this.count !== want && performance.now() < until) await new Promise((r) => setTimeout(r, 50));
+    }
     const report = {
       splats: this.count, renderer: this.renderer.rendererName, float_target: this.renderer.floatTarget,
-      user_agent: navigator.userAgent,
+      user_agent: navigator.userAgent, reloads: this.reloads, version: this.version,
     };
     if (params.has('controls')) {
       this.bindControls();
@@ -386,10 +452,13 @@ class Viewer {
 
 async function main() {
   const params = new URLSearchParams(location.search);
-  const [scene, buffer] = await loadSceneAndModel();
-  const viewer = new Viewer(scene, decodePayload(buffer));
+  const [scene, buffer, version] = await loadSceneAndModel();
+  const viewer = new Viewer(scene, decodePayload(buffer), version);
   if (params.has('bench')) await viewer.bench(params);
-  else viewer.start();
+  else {
+    viewer.start();
+    if (!window.__lgEmbedded) viewer.watchServer(3000);
+  }
 }
 
 main().catch((err) => window.__lgError(err && err.stack ? err.stack : err));

@@ -13,12 +13,34 @@ ViewerSite::ViewerSite(std::string model_payload, std::string scene_json, Viewer
       scene_(std::make_shared<const std::string>(std::move(scene_json))),
       options_(std::move(options)) {}
 
+void ViewerSite::replace(std::string model_payload, std::string scene_json) {
+    auto model = std::make_shared<const std::string>(std::move(model_payload));
+    auto scene = std::make_shared<const std::string>(std::move(scene_json));
+    const std::lock_guard lock(mutex_);
+    model_ = std::move(model);
+    scene_ = std::move(scene);
+    ++version_;
+}
+
+std::uint64_t ViewerSite::version() const {
+    const std::lock_guard lock(mutex_);
+    return version_;
+}
+
 HttpResponse ViewerSite::handle(const HttpRequest& request) {
     const auto target = parse_request_target(request.target);
     if (!target) return HttpResponse::text(400, "refused request target\n");
     const std::string& path = target->path;
-    if (path == "model.bin") return HttpResponse::shared("application/octet-stream", model_);
-    if (path == "scene.json") return HttpResponse::shared("application/json", scene_);
+    if (path == "model.bin" || path == "scene.json" || path == "version") {
+        const std::lock_guard lock(mutex_);
+        if (path == "model.bin") return HttpResponse::shared("application/octet-stream", model_);
+        if (path == "scene.json") return HttpResponse::shared("application/json", scene_);
+        HttpResponse r = HttpResponse::shared(
+            "application/json",
+            std::make_shared<const std::string>("{\"version\": " + std::to_string(version_) + "}\n"));
+        r.extra_headers.emplace_back("Cache-Control", "no-store");
+        return r;
+    }
     // GET only: a HEAD must not have the side effect of writing the report.
     if (path == "bench-report" && !options_.bench_report_path.empty() && request.method == "GET")
         return bench_report(target->query);
