@@ -3,6 +3,8 @@
 //   ply-3dgs         standard 3DGS PLY, colours baked under --light, both sides of each surfel in
 //   view-dependent
 //                    SH of --sh-degree (export/ply_3dgs.h, export/two_sided_sh.h)
+//   spz              Niantic's compressed SPZ (v3), baked like ply-3dgs, turned so that --up is +y
+//                    (export/spz_format.h)
 //   splat            the 32-byte-per-splat web format, baked under --light, the side the training photos see
 //                    (export/splat_format.h)
 //   ply-relightable  the relightable PLY plus FILE.environments.json (export/relightable_bundle.h)
@@ -23,6 +25,7 @@
 #include "lumigauss/export/ply_3dgs.h"
 #include "lumigauss/export/relightable_bundle.h"
 #include "lumigauss/export/splat_format.h"
+#include "lumigauss/export/spz_format.h"
 #include "lumigauss/export/two_sided_sh.h"
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/model/trained_run.h"
@@ -47,7 +50,7 @@ struct ExportOptions {
 };
 
 bool baked_format(const std::string& f) {
-    return f == "ply-3dgs" || f == "splat";
+    return f == "ply-3dgs" || f == "spz" || f == "splat";
 }
 
 void make_parent(const std::string& path) {
@@ -66,9 +69,8 @@ void run_export(const ExportOptions& o) {
     if (o.threads > 0)
         threads =
             std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, o.threads);
-    if (o.format != "ply-3dgs" && o.format != "splat" && o.format != "ply-relightable" && o.format != "env" &&
-        o.format != "html")
-        throw Error("--format '" + o.format + "': use ply-3dgs, splat, ply-relightable, env or html");
+    if (!baked_format(o.format) && o.format != "ply-relightable" && o.format != "env" && o.format != "html")
+        throw Error("--format '" + o.format + "': use ply-3dgs, spz, splat, ply-relightable, env or html");
     if (o.source.empty() == o.ply.empty())
         throw Error("export: give either a training run folder (or relightable .ply) or --ply FILE");
     const std::string source = o.source.empty() ? o.ply : o.source;
@@ -79,8 +81,9 @@ void run_export(const ExportOptions& o) {
     if (!baked && o.format != "html" && !o.light.empty())
         throw Error("--light is for the baked formats (ply-3dgs, splat) and html, not " + o.format);
     const BakeShading shading = parse_bake_shading(o.shading);
-    if (o.sh_degree_given && o.format != "ply-3dgs")
-        throw Error("--sh-degree is for --format ply-3dgs (" + o.format + " holds no view-dependent colour)");
+    if (o.sh_degree_given && o.format != "ply-3dgs" && o.format != "spz")
+        throw Error("--sh-degree is for --format ply-3dgs and spz (" + o.format +
+                    " holds no view-dependent colour)");
     if (o.sh_degree < 0 || o.sh_degree > 3)
         throw Error("--sh-degree " + std::to_string(o.sh_degree) + ": use 0, 1, 2 or 3");
 
@@ -104,6 +107,11 @@ void run_export(const ExportOptions& o) {
                            two_sided_view_sh(run.model, sides, o.sh_degree, run.photo_centres), o.sh_degree);
             how = o.sh_degree > 0 ? "both sides, SH degree " + std::to_string(o.sh_degree)
                                   : std::string("one colour: ") + seen_side_note(run);
+        } else if (o.format == "spz") {
+            write_spz_file(o.out, run.model, sides, o.sh_degree, up, run.photo_centres);
+            how = (o.sh_degree > 0 ? "both sides, SH degree " + std::to_string(o.sh_degree)
+                                   : std::string("one colour: ") + seen_side_note(run)) +
+                  "; turned so that up " + up_axis_name(up) + " is +y";
         } else {
             write_splat_file(
                 o.out, splat_records(run.model, seen_side_colours(run.model, sides, run.photo_centres)));
@@ -157,14 +165,16 @@ void register_export(CLI::App& app) {
     cmd->add_option("--ply", o->ply,
                     "a bare relightable PLY (official LumiGauss layout) instead of a run: no learned lights, "
                     "use --light with an SH .txt or a panorama");
-    cmd->add_option("--format", o->format, "ply-3dgs, splat, ply-relightable, env or html")->required();
-    cmd->add_option("-o,--output", o->out,
-                    "output file (ply-3dgs, splat, html; ply-relightable: FILE.ply + FILE.environments.json) "
-                    "or folder (env)")
+    cmd->add_option("--format", o->format, "ply-3dgs, spz, splat, ply-relightable, env or html")->required();
+    cmd->add_option(
+           "-o,--output", o->out,
+           "output file (ply-3dgs, spz, splat, html; ply-relightable: FILE.ply + FILE.environments.json) "
+           "or folder (env)")
         ->required();
-    cmd->add_option("--light", o->light,
-                    "ply-3dgs/splat: the lighting to bake, as for `render --light` (training photo, SH .txt, "
-                    "panorama; prefixes photo:, sh:, pano:); html: one more lighting, offered first");
+    cmd->add_option(
+        "--light", o->light,
+        "ply-3dgs/spz/splat: the lighting to bake, as for `render --light` (training photo, SH .txt, "
+        "panorama; prefixes photo:, sh:, pano:); html: one more lighting, offered first");
     cmd->add_option("--shading", o->shading,
                     "baked colour: shadowed (the full model: transfer sets) or unshadowed (the normals)")
         ->capture_default_str();
@@ -174,8 +184,8 @@ void register_export(CLI::App& app) {
                o->sh_degree = degree;
                o->sh_degree_given = true;
            },
-           "ply-3dgs: degree of the view-dependent colour (0: one colour, the side the training photos see; "
-           "1-3: each side of a surfel shows its own colour; default 3)")
+           "ply-3dgs, spz: degree of the view-dependent colour (0: one colour, the side the training photos "
+           "see; 1-3: each side of a surfel shows its own colour; default 3)")
         ->type_name("INT");
     cmd->add_option("--up", o->up,
                     "world up (panorama lights, --rotate, the bundle's up): +z, -y, +y, +x, -x, -z, a vector "

@@ -110,6 +110,17 @@ TEST(CliExport, EveryFormatAndImportFromBarePly) {
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(fs::file_size(tmp / "m.splat"), 32 * surfels);
 
+    // spz: gzip; the run's photos' up (the synthetic scene's +z) turned to +y.
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format spz --light " + shell_quoted(photos[0]) +
+                          " -o " + shell_quoted(tmp / "m.spz"),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("is +y"));
+    const std::string spz = synth_test::read_bytes(tmp / "m.spz");
+    ASSERT_GT(spz.size(), 2u);
+    EXPECT_EQ(std::uint8_t(spz[0]), 0x1f);
+    EXPECT_EQ(std::uint8_t(spz[1]), 0x8b);
+
     // html: one page holding the viewer, the model (base64) and the run's lights (the browser test opens
     // one).
     r = run_lumigauss(

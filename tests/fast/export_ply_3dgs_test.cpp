@@ -15,6 +15,7 @@
 #include <random>
 #include <sstream>
 
+#include "export_test_scene.h"
 #include "lumigauss/cameras/orbit.h"
 #include "lumigauss/export/baked_colours.h"
 #include "lumigauss/export/ply_3dgs.h"
@@ -24,6 +25,7 @@
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
 #include "lumigauss/util/error.h"
 #include "relight_test_util.h"
+#include "support/inria_sh.h"
 #include "support/random_surfels.h"
 #include "support/temp_dir.h"
 
@@ -31,6 +33,7 @@ namespace lumigauss {
 namespace {
 
 using lumigauss::testing::TempDir;
+using namespace lumigauss::export_test;
 
 // The 3DGS property list for an SH degree, written out independently of the exporter.
 std::vector<std::string> expected_properties(int degree) {
@@ -103,34 +106,14 @@ StrictPly read_strict_ply(const std::string& path) {
     return ply;
 }
 
-// The colour a 3DGS renderer gives vertex `row` seen along the unit direction `d` (camera -> splat): the
-// Inria code's eval_sh (its SH_C0..SH_C3 and term order), f_rest channel-major, + 0.5, clamped at 0.
+// The colour a 3DGS renderer gives vertex `row` seen along the unit direction `d` (camera -> splat), f_rest
+// channel-major as the Inria code stores it.
 Vec3d inria_colour(const StrictPly& ply, std::size_t row, int degree, Vec3d d) {
-    const double C0 = 0.28209479177387814, C1 = 0.4886025119029199;
-    const double C2[] = {1.0925484305920792, -1.0925484305920792, 0.31539156525252005, -1.0925484305920792,
-                         0.5462742152960396};
-    const double C3[] = {-0.5900435899266435, 2.890611442640554, -0.4570457994644658, 0.3731763325901154,
-                         -0.4570457994644658, 1.445305721320277, -0.5900435899266435};
     const int per_channel = (degree + 1) * (degree + 1) - 1;
-    Vec3d out;
-    for (int c = 0; c < 3; ++c) {
-        const auto f = [&](int k) {  // coefficient k >= 1 of channel c
-            return double(ply.at(row, "f_rest_" + std::to_string(c * per_channel + k - 1)));
-        };
-        const double x = d.x, y = d.y, z = d.z, xx = x * x, yy = y * y, zz = z * z;
-        double v = C0 * ply.at(row, "f_dc_" + std::to_string(c));
-        if (degree > 0) v += -C1 * y * f(1) + C1 * z * f(2) - C1 * x * f(3);
-        if (degree > 1)
-            v += C2[0] * x * y * f(4) + C2[1] * y * z * f(5) + C2[2] * (2 * zz - xx - yy) * f(6) +
-                 C2[3] * x * z * f(7) + C2[4] * (xx - yy) * f(8);
-        if (degree > 2)
-            v += C3[0] * y * (3 * xx - yy) * f(9) + C3[1] * x * y * z * f(10) +
-                 C3[2] * y * (4 * zz - xx - yy) * f(11) + C3[3] * z * (2 * zz - 3 * xx - 3 * yy) * f(12) +
-                 C3[4] * x * (4 * zz - xx - yy) * f(13) + C3[5] * z * (xx - yy) * f(14) +
-                 C3[6] * x * (xx - 3 * yy) * f(15);
-        out[c] = std::max(0.0, v + 0.5);
-    }
-    return out;
+    const double dc[3] = {ply.at(row, "f_dc_0"), ply.at(row, "f_dc_1"), ply.at(row, "f_dc_2")};
+    return lumigauss::testing::inria_sh_colour(
+        degree, dc,
+        [&](int k, int c) { return ply.at(row, "f_rest_" + std::to_string(c * per_channel + k - 1)); }, d);
 }
 
 // The file's splats as the rasterizer takes them, coloured for a camera at `eye` by inria_colour.
@@ -149,57 +132,6 @@ SurfelBatch<float> splats_for_view(const StrictPly& ply, int degree, Vec3d eye) 
         for (int c = 0; c < 3; ++c) b.colors[3 * i + std::size_t(c)] = float(rgb[c]);
     }
     return b;
-}
-
-// `count` surfels in the cube [-1, 1]^3 with random orientations: about half show each side to any camera.
-GaussianModel cube_model(std::uint64_t seed, std::size_t count = 120) {
-    auto raw = relight_test::random_raw(lumigauss::testing::test_camera(), seed, count);
-    std::mt19937_64 rng(seed + 1);
-    for (std::size_t i = 0; i < count; ++i) {
-        for (int k = 0; k < 3; ++k)
-            raw[int(ModelParam::Xyz)][3 * i + std::size_t(k)] = float(relight_test::uniform(rng));
-        for (int k = 0; k < 4; ++k)
-            raw[int(ModelParam::Rotation)][4 * i + std::size_t(k)] = float(relight_test::uniform(rng));
-        for (int k = 0; k < 2; ++k)
-            raw[int(ModelParam::Scaling)][2 * i + std::size_t(k)] =
-                float(relight_test::uniform(rng, -2.2, -1.4));
-        raw[int(ModelParam::Opacity)][i] = float(relight_test::uniform(rng, 0.0, 3.0));
-        // The back sides mostly in shadow: their transfer's DC at a third of the front's.
-        raw[int(ModelParam::TransferNegative)][i * kTransferStored] =
-            float(relight_test::uniform(rng, 0.2, 0.5));
-    }
-    return GaussianModel::from_raw(std::move(raw), 1.0);
-}
-
-// Cameras around the cube: six on a tilted ring and one above, 3.5 units from the centre.
-std::vector<Camera> ring_cameras() {
-    const Camera intrinsics = lumigauss::testing::test_camera(64, 48);
-    std::vector<Camera> cams;
-    for (int k = 0; k < 6; ++k) {
-        const double a = 2 * 3.141592653589793 * k / 6;
-        cams.push_back(look_at(intrinsics, {3.5 * std::cos(a), 3.5 * std::sin(a), std::cos(3 * a)}, {0, 0, 0},
-                               {0, 0, 1}));
-    }
-    cams.push_back(look_at(intrinsics, {0.3, 0.2, 3.5}, {0, 0, 0}, {0, 1, 0}));
-    return cams;
-}
-
-// A moderate environment with a strong direction (band 1): colours stay mostly below 1, and the two sides
-// of a surfel differ in unshadowed shading too.
-ShCoeffs<float> moderate_env() {
-    ShCoeffs<double> sh = relight_test::bright_sh(11);
-    for (int k = 0; k < kShCount; ++k) sh.c[k] = sh.c[k] * (k == 0 ? 0.5 : k < 4 ? 0.6 : 0.15);
-    return sh.cast<float>();
-}
-
-// PSNR of two colour maps, both clamped to the display range [0, 1].
-double display_psnr(const std::vector<float>& a, const std::vector<float>& b) {
-    double se = 0;
-    for (std::size_t p = 0; p < a.size(); ++p) {
-        const double d = std::clamp(double(a[p]), 0.0, 1.0) - std::clamp(double(b[p]), 0.0, 1.0);
-        se += d * d;
-    }
-    return 10 * std::log10(double(a.size()) / std::max(se, 1e-30));
 }
 
 struct ExportedFile {
