@@ -1,8 +1,7 @@
 // `lumigauss export SOURCE --format F [--light L] -o FILE`: converts a trained run (or a bare relightable
 // PLY in the official LumiGauss layout) into files other tools open (docs/formats.md):
-//   ply-3dgs         standard 3DGS PLY, colours baked under --light, both sides of each surfel in
-//   view-dependent
-//                    SH of --sh-degree (export/ply_3dgs.h, export/two_sided_sh.h)
+//   ply-3dgs         standard 3DGS PLY, colours baked under --light, both sides of each surfel
+//                    in view-dependent SH of --sh-degree (export/ply_3dgs.h, export/two_sided_sh.h)
 //   spz              Niantic's compressed SPZ (v3), baked like ply-3dgs, turned so that --up is +y
 //                    (export/spz_format.h)
 //   splat            the 32-byte-per-splat web format, baked under --light, the side the training photos see
@@ -79,7 +78,7 @@ void run_export(const ExportOptions& o) {
     const bool baked = baked_format(o.format);
     if (baked && o.light.empty()) throw Error("--format " + o.format + " bakes colours: give --light");
     if (!baked && o.format != "html" && !o.light.empty())
-        throw Error("--light is for the baked formats (ply-3dgs, splat) and html, not " + o.format);
+        throw Error("--light is for the baked formats (ply-3dgs, spz, splat) and html, not " + o.format);
     const BakeShading shading = parse_bake_shading(o.shading);
     if (o.sh_degree_given && o.format != "ply-3dgs" && o.format != "spz")
         throw Error("--sh-degree is for --format ply-3dgs and spz (" + o.format +

@@ -62,6 +62,9 @@ class StopSignals {
 
 void run_view(const ViewOptions& o) {
     const ViewerSceneOptions scene_options{o.source, o.scene, o.camera_json, o.up, o.lights};
+    // The files' state before they are read: a snapshot written while they load is served next.
+    const RunPaths watched = run_paths_of(o.source);
+    const std::string fingerprint = model_files_fingerprint(watched);
     const TrainedRun run = load_run_or_ply(o.source);
     const view::ViewerScene scene = viewer_scene_for(run, scene_options);
 
@@ -81,7 +84,7 @@ void run_view(const ViewOptions& o) {
     StopSignals signals(server);
     // A running training run writes a newer snapshot with every checkpoint: the page follows it.
     const ModelReloader reloader(
-        run.paths, site,
+        watched, fingerprint, site,
         [&scene_options] {
             const TrainedRun newer = load_run_or_ply(scene_options.source);
             return std::pair{view::encode_model_payload(newer.model),

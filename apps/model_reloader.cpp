@@ -1,8 +1,7 @@
 #include "model_reloader.h"
 
+#include <exception>
 #include <filesystem>
-
-#include "lumigauss/util/error.h"
 
 namespace lumigauss::cli {
 
@@ -20,9 +19,10 @@ std::string model_files_fingerprint(const RunPaths& paths) {
     return fingerprint;
 }
 
-ModelReloader::ModelReloader(RunPaths paths, view::ViewerSite& site, Loader load,
+ModelReloader::ModelReloader(RunPaths paths, std::string loaded, view::ViewerSite& site, Loader load,
                              std::function<void(const std::string&)> report, std::chrono::milliseconds period)
     : paths_(std::move(paths)),
+      loaded_(std::move(loaded)),
       site_(site),
       load_(std::move(load)),
       report_(std::move(report)),
@@ -39,7 +39,7 @@ ModelReloader::~ModelReloader() {
 }
 
 void ModelReloader::watch() {
-    std::string loaded = model_files_fingerprint(paths_), failed;
+    std::string loaded = loaded_, failed;
     std::unique_lock lock(mutex_);
     while (!wake_.wait_for(lock, period_, [this] { return stop_; })) {
         const std::string now = model_files_fingerprint(paths_);
@@ -51,7 +51,7 @@ void ModelReloader::watch() {
             loaded = now;
             report_("newer model files in " + paths_.dir + ": reloaded (version " +
                     std::to_string(site_.version()) + "); open pages follow");
-        } catch (const Error& e) {
+        } catch (const std::exception& e) {  // Error, and what libraries throw (bad_alloc, JSON, files)
             failed = now;
             report_(
                 std::string("could not reload (keeping the current model until the files change again): ") +

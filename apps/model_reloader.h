@@ -25,7 +25,9 @@ class ModelReloader {
     // `load` reads the run again and returns the new payload and scene JSON (throws Error when it cannot);
     // `report` receives one line per reload or failure.
     using Loader = std::function<std::pair<std::string, std::string>()>;
-    ModelReloader(RunPaths paths, view::ViewerSite& site, Loader load,
+    // `loaded`: model_files_fingerprint(paths) taken BEFORE the model the site serves was loaded, so that a
+    // snapshot written while it loaded is not taken for the one being served.
+    ModelReloader(RunPaths paths, std::string loaded, view::ViewerSite& site, Loader load,
                   std::function<void(const std::string&)> report,
                   std::chrono::milliseconds period = std::chrono::seconds(2));
     ~ModelReloader();  // stops and joins the thread
@@ -36,6 +38,7 @@ class ModelReloader {
     void watch();
 
     RunPaths paths_;
+    std::string loaded_;
     view::ViewerSite& site_;
     Loader load_;
     std::function<void(const std::string&)> report_;

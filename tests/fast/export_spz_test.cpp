@@ -195,6 +195,25 @@ TEST(ExportSpz, HeaderAndKnownValues) {
     EXPECT_THROW(write_spz_file(tmp / "bad.spz", model, sides, 4, {0, 1, 0}, {}), Error);
 }
 
+// The rotation bits of a quaternion with no ties: (w, x, y, z) = (0.1, 0.7, -0.5, 0.5), x largest and
+// positive; then y (sign 1, round(511 * 0.5 * sqrt 2) = 361), z (0, 361), w (0, round(72.27) = 72), the first
+// in the highest bits after the 2-bit index 0: ((873 << 10 | 361) << 10) | 72.
+TEST(ExportSpz, RotationBitsKnownAnswer) {
+    TempDir tmp("export_spz_rotation");
+    std::vector<std::vector<float>> raw(kModelParamCount);
+    for (int p = 0; p < kModelParamCount; ++p)
+        raw[std::size_t(p)].assign(std::size_t(SurfelModel::width(ModelParam(p))), 0.0f);
+    raw[int(ModelParam::Rotation)] = {0.1f, 0.7f, -0.5f, 0.5f};
+    const SurfelModel model = SurfelModel::from_raw(std::move(raw));
+    const SurfelSides sides{{0.5f, 0.5f, 0.5f}, {0.5f, 0.5f, 0.5f}};
+    write_spz_file(tmp / "q.spz", model, sides, 0, {0, 1, 0}, {});
+    const std::string s = gunzip(tmp / "q.spz");
+    ASSERT_EQ(s.size(), 16u + 9 + 1 + 3 + 3 + 4);
+    EXPECT_EQ(u32(s, 16 + 9 + 1 + 3 + 3), 915776584u);
+    const SpzSplat back = read_spz(tmp / "q.spz").splats.at(0);
+    EXPECT_NEAR(back.wxyz[0] * 0.1 + back.wxyz[1] * 0.7 - back.wxyz[2] * 0.5 + back.wxyz[3] * 0.5, 1.0, 2e-3);
+}
+
 // From cameras all around (in a z-up world, so the turn matters), the SPZ file renders like the relightable
 // model; the quantisation (8-bit colours, 1/16 log-scale steps, 4-5 bit SH) costs some dB against the PLY.
 void expect_spz_render(BakeShading bake, ShadingMode mode, double min_psnr) {

@@ -105,7 +105,9 @@ std::string spz_stream(const SurfelModel& model, const SurfelSides& sides, int s
     for (std::size_t i = 0; i < n; ++i) {
         const Vec3d p = R * Vec3d{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
         for (int k = 0; k < 3; ++k) {
-            if (!(std::abs(p[k]) * (1 << kSpzFractionalBits) < double(1 << 23)))
+            // The fixed-point value written below (from the float), within 24 signed bits.
+            const double fixed = std::round(double(float(p[k])) * (1 << kSpzFractionalBits));
+            if (!(std::abs(fixed) < double(1 << 23)))
                 throw Error("SPZ: surfel " + std::to_string(i) + " lies " + std::to_string(std::abs(p[k])) +
                             " units from the origin: SPZ's 24-bit positions hold less than 2048");
             xyz[3 * i + std::size_t(k)] = float(p[k]);

@@ -127,6 +127,15 @@ bool is_bare_ply(const std::string& path) {
     return ext == ".ply" && fs::is_regular_file(path);
 }
 
+RunPaths run_paths_of(const std::string& path) {
+    namespace fs = std::filesystem;
+    if (fs::is_directory(path)) return run_paths(path);
+    const fs::path parent = fs::path(path).parent_path();
+    RunPaths paths = run_paths(parent.empty() ? std::string(".") : parent.string());
+    paths.model = path;
+    return paths;
+}
+
 TrainedRun load_run_or_ply(const std::string& path) {
     namespace fs = std::filesystem;
     if (fs::is_directory(path)) return load_trained_run(path);
@@ -136,10 +145,8 @@ TrainedRun load_run_or_ply(const std::string& path) {
         fail_in_file(path,
                      "neither a training run folder nor a .ply file in the LumiGauss relightable layout");
     TrainedRun run;
-    const fs::path parent = fs::path(path).parent_path();
-    run.dir = parent.empty() ? std::string(".") : parent.string();
-    run.paths = run_paths(run.dir);
-    run.paths.model = path;
+    run.paths = run_paths_of(path);
+    run.dir = run.paths.dir;
     run.paths.appearance = path + " (bare PLY: no training photos)";
     run.model = load_relightable_ply(path);
     return run;

@@ -48,6 +48,10 @@ TrainedRun load_trained_run(const std::string& dir);
 // True when `path` names a regular file ending in .ply (case-insensitive).
 bool is_bare_ply(const std::string& path);
 
+// The files load_run_or_ply(path) reads: a run folder's (run_paths), or for a bare PLY its folder's with
+// `model` the PLY itself.
+RunPaths run_paths_of(const std::string& path);
+
 // A run folder through load_trained_run, or a bare relightable PLY in the official LumiGauss layout
 // (model/relightable_ply.h: what the Python code's `save_ply` writes, and a run's model.ply) as a run with no
 // photos (dir = the PLY's folder, paths.model = the PLY), so that models trained with the official code can

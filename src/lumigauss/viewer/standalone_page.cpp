@@ -49,7 +49,7 @@ Module translate_module(const std::string& file) {
     for (std::string line; std::getline(in, line);) {
         ++number;
         std::smatch match;
-        if (std::regex_match(line, match, import_line)) {
+        if (std::regex_match(line, match, import_line) && match[1].str().find(" as ") == std::string::npos) {
             m.imports.push_back(match[2]);
             body << "const {" << match[1].str() << "} = " << module_variable(match[2]) << ";\n";
         } else if (std::regex_search(line, match, export_line)) {
@@ -80,7 +80,9 @@ void add_in_order(const std::string& file, std::map<std::string, Module>& module
 
 // Text that sits inside a <script> element: "</script" or "<!--" there would end or confuse it.
 void check_script_safe(const std::string& text, const std::string& what) {
-    if (text.find("</script") != std::string::npos || text.find("<!--") != std::string::npos)
+    std::string lower(text);
+    for (char& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));  // </SCRIPT ends it too
+    if (lower.find("</script") != std::string::npos || lower.find("<!--") != std::string::npos)
         throw Error("viewer page: " + what + " holds '</script' or '<!--'");
 }
 

@@ -35,11 +35,10 @@ HttpResponse ViewerSite::handle(const HttpRequest& request) {
         const std::lock_guard lock(mutex_);
         if (path == "model.bin") return HttpResponse::shared("application/octet-stream", model_);
         if (path == "scene.json") return HttpResponse::shared("application/json", scene_);
-        HttpResponse r = HttpResponse::shared(
+        // Every response says Cache-Control: no-store (http_message.h), so the page's polls see each version.
+        return HttpResponse::shared(
             "application/json",
             std::make_shared<const std::string>("{\"version\": " + std::to_string(version_) + "}\n"));
-        r.extra_headers.emplace_back("Cache-Control", "no-store");
-        return r;
     }
     // GET only: a HEAD must not have the side effect of writing the report.
     if (path == "bench-report" && !options_.bench_report_path.empty() && request.method == "GET")
