@@ -426,7 +426,9 @@ TEST(CliViewBrowser, RendersWithoutErrorsAndMatchesTheCppRenderer) {
     EXPECT_GT(r["sort_ms"]["count"].get<int>(), 0) << "the worker sorted nothing";
     EXPECT_GT(r["nonblank_fraction"].get<double>(), 0.01) << "the orbit frames are blank";
     for (const auto& [name, ok] : r["controls"].items()) EXPECT_TRUE(ok.get<bool>()) << "control " << name;
-    EXPECT_GE(r["controls"].size(), 9u);
+    EXPECT_GE(r["controls"].size(), 12u);
+    for (const char* control : {"drop_sh_file", "panel_toggle", "loading_hidden"})
+        EXPECT_TRUE(r["controls"].contains(control)) << control;
     std::printf("  %s, %s target: frame median %.1f ms\n", r["renderer"].get<std::string>().c_str(),
                 r["float_target"].get<bool>() ? "float" : "8-bit", r["frame_ms"]["median"].get<double>());
 

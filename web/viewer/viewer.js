@@ -88,9 +88,41 @@ async function loadSceneAndModel() {
   const version = await serverVersion();
   const [scene, buffer] = await Promise.all([
     fetchOk('scene.json').then((r) => r.json()),
-    fetchOk('model.bin').then((r) => r.arrayBuffer()),
+    fetchWithProgress('model.bin', showLoadingProgress),
   ]);
   return [scene, buffer, version];
+}
+
+// The body of `url` as an ArrayBuffer, reporting (received, total bytes) as it arrives.
+async function fetchWithProgress(url, progress) {
+  const r = await fetchOk(url);
+  const total = Number(r.headers.get('Content-Length')) || 0;
+  if (!r.body || !total) return r.arrayBuffer();
+  const bytes = new Uint8Array(total);
+  const reader = r.body.getReader();
+  let received = 0;
+  for (;;) {
+    const { done, value } = await reader.read();
+    if (done) break;
+    if (received + value.length > total) throw new Error(`${url}: more bytes than its Content-Length`);
+    bytes.set(value, received);
+    received += value.length;
+    progress(received, total);
+  }
+  if (received !== total) throw new Error(`${url}: ${received} of ${total} bytes arrived`);
+  return bytes.buffer;
+}
+
+function showLoadingProgress(received, total) {
+  const bar = $('loadingBar');
+  if (!bar) return;
+  bar.max = total;
+  bar.value = received;
+}
+
+function hideLoading() {
+  const box = $('loading');
+  if (box) box.hidden = true;
 }
 
 async function fetchOk(url) {
@@ -133,10 +165,7 @@ class Viewer {
     this.renderer = new SplatRenderer($('canvas'));
     this.renderer.setModel(packSplats(model, this.renderer.maxTextureSize));
     this.camera = new OrbitCamera(scene);
-    this.sorter = new DepthSorter(model.xyz, (indices, count) => {
-      this.renderer.setOrder(indices, count);
-      this.dirty = true;
-    });
+    this.sorter = this.makeSorter(model);
     this.count = model.count;
     this.dirty = true;
     this.updateEnvironment();
@@ -150,21 +179,29 @@ class Viewer {
     this.dirty = true;
   }
 
+  // The depth sorter of `model`; its results are dropped once another sorter has replaced it.
+  makeSorter(model) {
+    const sorter = new DepthSorter(model.xyz, (indices, count) => {
+      if (this.sorter !== sorter) return;
+      this.renderer.setOrder(indices, count);
+      this.dirty = true;
+    });
+    return sorter;
+  }
+
   // A newer model from the server (a running training's snapshot): the view, the controls and the chosen
   // light (by name) stay as they are.
   replaceModel(scene, model, version) {
     const lightName = this.lights[this.lightIndex].name;
-    const added = this.lights.filter((l) => l.kind === 'SH file');  // loaded in this page: keep them
+    const added = this.lights.filter((l) => l.local);  // SH files loaded in this page: keep them
     this.scene = Object.assign(scene, { up: this.scene.up, e1: this.scene.e1, e2: this.scene.e2 });
     this.lights = scene.lights.map((l) => ({ name: l.name, kind: l.kind, sh: l.sh })).concat(added);
     const same = this.lights.findIndex((l) => l.name === lightName);
     this.lightIndex = same >= 0 ? same : scene.initial_light || 0;
-    this.renderer.setModel(packSplats(model, this.renderer.maxTextureSize));
+    // The old worker first: no order for the old model may reach the new one's buffers.
     this.sorter.worker.terminate();
-    this.sorter = new DepthSorter(model.xyz, (indices, count) => {
-      this.renderer.setOrder(indices, count);
-      this.dirty = true;
-    });
+    this.sorter = this.makeSorter(model);
+    this.renderer.setModel(packSplats(model, this.renderer.maxTextureSize));
     this.count = model.count;
     this.version = version;
     this.reloads += 1;
@@ -249,6 +286,24 @@ class Viewer {
 
   bindControls() {
     this.fillLightMenu();
+    // The side panel: hidden with the toggle, and from the start on small windows.
+    if (window.innerWidth < 700) document.body.classList.add('collapsed');
+    $('panelToggle').onclick = () => {
+      document.body.classList.toggle('collapsed');
+      this.dirty = true;
+    };
+    // An SH file dropped on the view lights the model, as the file input does.
+    const view = $('view');
+    view.addEventListener('dragover', (e) => {
+      e.preventDefault();
+      view.classList.add('dropping');
+    });
+    view.addEventListener('dragleave', () => view.classList.remove('dropping'));
+    view.addEventListener('drop', (e) => {
+      e.preventDefault();
+      view.classList.remove('dropping');
+      if (e.dataTransfer && e.dataTransfer.files.length) this.loadShFile(e.dataTransfer.files[0]);
+    });
     const touch = () => (this.dirty = true);
     $('light').onchange = (e) => { this.lightIndex = Number(e.target.value); this.updateEnvironment(); };
     $('rotation').oninput = (e) => {
@@ -275,7 +330,7 @@ class Viewer {
     if (!file) return;
     try {
       const sh = parseShText(await file.text());
-      this.lights.push({ name: file.name, kind: 'SH file', sh });
+      this.lights.push({ name: file.name, kind: 'SH file', sh, local: true });
       this.lightIndex = this.lights.length - 1;
       this.fillLightMenu();
       this.updateEnvironment();
@@ -402,6 +457,22 @@ class Viewer {
     checks.zoom = this.camera.distance > dist;
     canvas.dispatchEvent(new MouseEvent('dblclick'));
     checks.reset = this.camera.azimuth === az && this.camera.distance === dist;
+    // An SH file dropped on the view.
+    const dropped = new DataTransfer();
+    dropped.items.add(new File(['0.5 0.5 0.5\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n'], 'dropped_sh.txt'));
+    $('view').dispatchEvent(new DragEvent('drop', { dataTransfer: dropped, cancelable: true }));
+    for (let i = 0; i < 50 && this.lights[this.lightIndex].name !== 'dropped_sh.txt'; ++i) await nextFrame();
+    checks.drop_sh_file = this.lights[this.lightIndex].name === 'dropped_sh.txt';
+    this.lights.pop();
+    this.lightIndex = this.lights.length - 1;  // the SH file loaded above, removed below
+    // The panel toggle, twice; the loading indicator is gone once the viewer runs.
+    const panelShown = () => getComputedStyle($('panel')).display !== 'none';
+    const before = panelShown();
+    $('panelToggle').click();
+    const toggled = panelShown() !== before;
+    $('panelToggle').click();
+    checks.panel_toggle = toggled && panelShown() === before;
+    checks.loading_hidden = $('loading').hidden === true;
     // Back to the state the rest of the bench expects.
     fire('rotation', 'input', '0');
     fire('exposure', 'input', '0');
@@ -454,6 +525,7 @@ async function main() {
   const params = new URLSearchParams(location.search);
   const [scene, buffer, version] = await loadSceneAndModel();
   const viewer = new Viewer(scene, decodePayload(buffer), version);
+  hideLoading();
   if (params.has('bench')) await viewer.bench(params);
   else {
     viewer.start();
