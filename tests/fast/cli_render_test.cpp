@@ -14,6 +14,16 @@ namespace {
 
 using test::TempDir;
 
+// One grey surfel at the origin, degree 0: a model for tests about which views get rendered.
+void save_one_surfel_ply(const std::string& path) {
+    ViewDependentSurfels m;
+    m.sh_degree = 0;
+    m.surfels.resize(1);
+    m.sh.assign(3, 0.f);
+    m.surfels.quats[0] = 1.f, m.surfels.scales[0] = m.surfels.scales[1] = 0.2f, m.surfels.opacities[0] = 0.8f;
+    save_2dgs_ply(path, m);
+}
+
 TEST(CliRender, WritesOnePngPerViewMatchingTheLibrary) {
     TempDir dir;
     test::write_scene(dir.path() / "scene", test::small_model(2, 48, 32));
@@ -64,12 +74,7 @@ TEST(CliRender, WritesOnePngPerViewMatchingTheLibrary) {
 TEST(CliRender, CamerasChooseThePlyViews) {
     TempDir dir;
     test::write_scene(dir.path() / "scene", test::small_model(2, 24, 16));
-    ViewDependentSurfels m;
-    m.sh_degree = 0;
-    m.surfels.resize(1);
-    m.sh.assign(3, 0.f);
-    m.surfels.quats[0] = 1.f, m.surfels.scales[0] = m.surfels.scales[1] = 0.2f, m.surfels.opacities[0] = 0.8f;
-    save_2dgs_ply(dir / "model.ply", m);
+    save_one_surfel_ply(dir / "model.ply");
     const Dataset scene = load_dataset(dir / "scene");
     const auto pngs = [](const std::filesystem::path& folder) {
         std::size_t count = 0;
@@ -125,12 +130,7 @@ TEST(CliRender, CudaBackendWithoutGpuSaysWhy) {
     if (cuda_backend_available()) GTEST_SKIP() << "a GPU is usable here";
     TempDir dir;
     test::write_scene(dir.path() / "scene", test::small_model(1, 16, 16));
-    ViewDependentSurfels m;
-    m.sh_degree = 0;
-    m.surfels.resize(1);
-    m.sh.assign(3, 0.f);
-    m.surfels.quats[0] = 1.f, m.surfels.scales[0] = m.surfels.scales[1] = 0.2f, m.surfels.opacities[0] = 0.8f;
-    save_2dgs_ply(dir / "model.ply", m);
+    save_one_surfel_ply(dir / "model.ply");
     const std::string cmd = std::string(LUMIGAUSS_BINARY) + " render --ply " + (dir / "model.ply") +
                             " --scene " + (dir / "scene") + " -o " + (dir / "out") + " --backend cuda > " +
                             (dir / "log.txt") + " 2>&1";

@@ -21,6 +21,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
@@ -337,6 +339,17 @@ double psnr(const std::vector<unsigned char>& page, const Image& cpu) {
     return mse > 0 ? 10 * std::log10(1.0 / mse) : 99.0;
 }
 
+// Headless Chromium on `url` (software WebGL, a fresh profile in `tmp`, output in tmp/browser.txt), leading
+// its own process group.
+pid_t spawn_browser(const TempDir& tmp, const std::string& chromium, const std::string& url) {
+    return spawn(
+        {chromium, "--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+         "--user-data-dir=" + tmp / "profile", "--window-size=640,480", "--force-device-scale-factor=1",
+         "--no-first-run", "--no-default-browser-check", "--disable-extensions",
+         "--disable-background-networking", "--disable-dev-shm-usage", "--mute-audio", url},
+        tmp / "browser.txt", true);
+}
+
 struct BrowserRun {
     nlohmann::json report;
     std::string server_log, browser_log;
@@ -354,13 +367,7 @@ std::optional<BrowserRun> run_in_browser(const TempDir& tmp, const std::string& 
     BrowserRun run;
     pid_t browser = -1;
     if (port) {
-        browser = spawn(
-            {chromium, "--headless=new", "--no-sandbox", "--use-angle=swiftshader",
-             "--enable-unsafe-swiftshader", "--user-data-dir=" + tmp / "profile", "--window-size=640,480",
-             "--force-device-scale-factor=1", "--no-first-run", "--no-default-browser-check",
-             "--disable-extensions", "--disable-background-networking", "--disable-dev-shm-usage",
-             "--mute-audio", "http://127.0.0.1:" + std::to_string(*port) + "/?" + query},
-            tmp / "browser.txt", true);
+        browser = spawn_browser(tmp, chromium, "http://127.0.0.1:" + std::to_string(*port) + "/?" + query);
     }
     const std::optional<int> code = browser > 0 ? wait_for_exit(server, 45) : std::nullopt;
     if (!code) end_child(server, false);
@@ -451,6 +458,52 @@ TEST(CliViewBrowser, RendersWithoutErrorsAndMatchesTheCppRenderer) {
         {{"shadowed", 40}, {"unshadowed", 40}, {"albedo", 40}, {"normals", 30}, {"shadow", 40}});
 }
 
+// Serves the page's requests in this process with `route` (and /bench-report itself), opens `target` (path
+// and query) in headless Chromium and returns the page's bench report, or nothing after 60 s. `waiting` runs
+// on this thread every 20 ms until the report arrives (the reload test hands the site a newer model there).
+std::optional<nlohmann::json> report_from_page(
+    const TempDir& tmp, const std::string& chromium, const std::string& target,
+    const std::function<view::HttpResponse(const view::HttpRequest&)>& route,
+    const std::function<void()>& waiting = {}) {
+    std::optional<std::string> report;
+    std::mutex mutex;
+    view::HttpServer* server_ptr = nullptr;
+    view::HttpServerOptions options;
+    options.max_request_bytes = 8u << 20;  // the report rides in the query string
+    view::HttpServer server(options, [&](const view::HttpRequest& request) {
+        const auto parsed = view::parse_request_target(request.target);
+        if (parsed && parsed->path == "bench-report") {
+            const auto query = view::parse_query(parsed->query);
+            const std::lock_guard lock(mutex);
+            if (query && query->count("data") && !report) report = query->at("data");
+            server_ptr->stop();
+            return view::HttpResponse::text(200, "ok");
+        }
+        return route(request);
+    });
+    server_ptr = &server;
+    std::thread serving([&server] { server.run(); });
+    const pid_t browser =
+        spawn_browser(tmp, chromium, "http://127.0.0.1:" + std::to_string(server.port()) + target);
+    const auto arrived = [&] {
+        const std::lock_guard lock(mutex);
+        return report.has_value();
+    };
+    const auto end = Clock::now() + std::chrono::seconds(60);
+    while (browser > 0 && !arrived() && Clock::now() < end) {
+        if (waiting) waiting();
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    server.stop();
+    serving.join();
+    if (browser > 0) end_child(browser, true);
+    if (!report) {
+        ADD_FAILURE() << "no report from the page\n" << read_text(tmp / "browser.txt");
+        return std::nullopt;
+    }
+    return nlohmann::json::parse(*report);
+}
+
 // `export --format html`: the page with the model inside, in headless Chromium with nothing else: served
 // here as a single file by a bare server that knows no viewer routes (only the page and the bench report),
 // so the scene, the model, the modules and the sorting worker can only come from the page itself. No
@@ -473,12 +526,9 @@ TEST(CliViewBrowser, ExportedPageWorksAlone) {
         << exported.output;
 
     const auto page = std::make_shared<const std::string>(read_text(tmp / "page.html"));
-    std::optional<std::string> report;
     std::vector<std::string> other_requests;
-    view::HttpServer* server_ptr = nullptr;
-    view::HttpServerOptions options;
-    options.max_request_bytes = 8u << 20;  // the report rides in the query string
-    view::HttpServer server(options, [&](const view::HttpRequest& request) {
+    std::mutex other_mutex;  // the server answers each connection on its own thread
+    const auto route = [&](const view::HttpRequest& request) {
         const auto target = view::parse_request_target(request.target);
         if (target && target->path == "page.html") {
             view::HttpResponse r;
@@ -487,34 +537,16 @@ TEST(CliViewBrowser, ExportedPageWorksAlone) {
             r.owner = page;
             return r;
         }
-        if (target && target->path == "bench-report" && !report) {
-            const auto query = view::parse_query(target->query);
-            if (query && query->count("data")) report = query->at("data");
-            server_ptr->stop();
-            return view::HttpResponse::text(200, "ok");
-        }
+        const std::lock_guard lock(other_mutex);
         other_requests.push_back(request.target);
         return view::HttpResponse::text(404, "not here");
-    });
-    server_ptr = &server;
-    std::thread serving([&server] { server.run(); });
-    const pid_t browser = spawn(
-        {*chromium, "--headless=new", "--no-sandbox", "--use-angle=swiftshader",
-         "--enable-unsafe-swiftshader", "--user-data-dir=" + tmp / "profile", "--window-size=640,480",
-         "--force-device-scale-factor=1", "--no-first-run", "--no-default-browser-check",
-         "--disable-extensions", "--disable-background-networking", "--disable-dev-shm-usage", "--mute-audio",
-         "http://127.0.0.1:" + std::to_string(server.port()) + "/page.html?bench=2&cam=" + camera_param(cam)},
-        tmp / "browser.txt", true);
-    const auto end = Clock::now() + std::chrono::seconds(60);
-    while (browser > 0 && !report && Clock::now() < end)
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    server.stop();
-    serving.join();
-    if (browser > 0) end_child(browser, true);
-    ASSERT_TRUE(report) << "no report from the page\n" << read_text(tmp / "browser.txt");
+    };
+    const auto report =
+        report_from_page(tmp, *chromium, "/page.html?bench=2&cam=" + camera_param(cam), route);
+    ASSERT_TRUE(report);
     for (const std::string& t : other_requests)
         EXPECT_TRUE(t.rfind("/favicon.ico", 0) == 0) << "the page asked the server for " << t;
-    const nlohmann::json r = nlohmann::json::parse(*report);
+    const nlohmann::json& r = *report;
     EXPECT_TRUE(r["errors"].empty()) << r["errors"].dump(2);
     ASSERT_FALSE(r.value("failed", false)) << r.dump(2);
     EXPECT_EQ(r["splats"], 400);
@@ -542,46 +574,23 @@ TEST(CliViewBrowser, PageReloadsANewerModel) {
     // The newer model replaces model.ply, which expect_shots_match renders.
     save_relightable_ply(tmp / "model.ply", relight_test::random_model(cam, 33, 300));
     std::atomic<bool> fetched{false};
-    std::optional<std::string> report;
-    view::HttpServer* server_ptr = nullptr;
-    view::HttpServerOptions options;
-    options.max_request_bytes = 8u << 20;
-    view::HttpServer server(options, [&](const view::HttpRequest& request) {
+    bool replaced = false;
+    const auto route = [&](const view::HttpRequest& request) {
         const auto target = view::parse_request_target(request.target);
-        if (target && target->path == "bench-report") {
-            const auto query = view::parse_query(target->query);
-            if (query && query->count("data") && !report) report = query->at("data");
-            server_ptr->stop();
-            return view::HttpResponse::text(200, "ok");
-        }
         if (target && target->path == "model.bin") fetched = true;
         return site.handle(request);
-    });
-    server_ptr = &server;
-    std::thread serving([&server] { server.run(); });
-    const pid_t browser = spawn(
-        {*chromium, "--headless=new", "--no-sandbox", "--use-angle=swiftshader",
-         "--enable-unsafe-swiftshader", "--user-data-dir=" + tmp / "profile", "--window-size=640,480",
-         "--force-device-scale-factor=1", "--no-first-run", "--no-default-browser-check",
-         "--disable-extensions", "--disable-background-networking", "--disable-dev-shm-usage", "--mute-audio",
-         "http://127.0.0.1:" + std::to_string(server.port()) +
-             "/?bench=1&reload=300&cam=" + camera_param(cam)},
-        tmp / "browser.txt", true);
-    auto end = Clock::now() + std::chrono::seconds(60);
-    while (browser > 0 && !fetched && Clock::now() < end)
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    if (fetched)
+    };
+    const auto hand_over_the_newer_model = [&] {
+        if (!fetched || replaced) return;
         site.replace(view::encode_model_payload(load_relightable_ply(tmp / "model.ply")),
                      scene_of(tmp / "model.ply"));
-    end = Clock::now() + std::chrono::seconds(60);
-    while (browser > 0 && !report && Clock::now() < end)
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    server.stop();
-    serving.join();
-    if (browser > 0) end_child(browser, true);
-    ASSERT_TRUE(fetched) << "the page never fetched the model\n" << read_text(tmp / "browser.txt");
-    ASSERT_TRUE(report) << "no report from the page\n" << read_text(tmp / "browser.txt");
-    const nlohmann::json r = nlohmann::json::parse(*report);
+        replaced = true;
+    };
+    const auto report = report_from_page(tmp, *chromium, "/?bench=1&reload=300&cam=" + camera_param(cam),
+                                         route, hand_over_the_newer_model);
+    ASSERT_TRUE(replaced) << "the page never fetched the model\n" << read_text(tmp / "browser.txt");
+    ASSERT_TRUE(report);
+    const nlohmann::json& r = *report;
     EXPECT_TRUE(r["errors"].empty()) << r["errors"].dump(2);
     EXPECT_EQ(r["splats"], 300);
     EXPECT_EQ(r["reloads"], 1);
