@@ -44,6 +44,7 @@ struct ExportOptions {
     int width = 512;
     int sh_degree = 3;
     bool sh_degree_given = false;
+    std::vector<std::string> bake_options_given;  // options that only shape a baked light
     int threads = 0;
     bool quiet = false;
 };
@@ -83,6 +84,11 @@ void run_export(const ExportOptions& o) {
     if (o.sh_degree_given && o.format != "ply-3dgs" && o.format != "spz")
         throw Error("--sh-degree is for --format ply-3dgs and spz (" + o.format +
                     " holds no view-dependent colour)");
+    // The page relights in the browser (rotation and exposure are its sliders): nothing is baked into it.
+    if (!baked && !o.bake_options_given.empty())
+        throw Error(o.bake_options_given.front() + " shapes a baked light (ply-3dgs, spz, splat); " +
+                    o.format + " bakes none" +
+                    (o.format == "html" ? " (the page has rotation and exposure sliders)" : ""));
     if (o.sh_degree < 0 || o.sh_degree > 3)
         throw Error("--sh-degree " + std::to_string(o.sh_degree) + ": use 0, 1, 2 or 3");
 
@@ -203,7 +209,13 @@ void register_export(CLI::App& app) {
                     "env: width of the EXR previews (height = width / 2)")
         ->capture_default_str();
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)");
-    cmd->callback([o] { run_export(*o); });
+    cmd->callback([o, cmd] {
+        ExportOptions opts = *o;
+        for (const char* bake_only :
+             {"--shading", "--rotate", "--exposure", "--match-exposure", "--hdr-threshold", "--hdr-scale"})
+            if (cmd->count(bake_only) > 0) opts.bake_options_given.push_back(bake_only);
+        run_export(opts);
+    });
 }
 
 }  // namespace lumigauss::cli

@@ -170,6 +170,14 @@ TEST(CliExport, BadInputNamesTheProblem) {
     EXPECT_THAT(r.output, HasSubstr("nope.txt"));
     EXPECT_FALSE(fs::exists(tmp / "m.ply"));
 
+    // A baked light's options on a format that bakes none are refused, not ignored.
+    r = run_lumigauss(
+        "export " + shell_quoted(t.run) + " --format html --rotate 30 -o " + shell_quoted(tmp / "page.html"),
+        tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("--rotate shapes a baked light"));
+    EXPECT_FALSE(fs::exists(tmp / "page.html"));
+
     // --sh-degree: 0..3, and only for ply-3dgs.
     const std::string light = shell_quoted(load_appearance(run_paths(t.run).appearance).at(0));
     r = run_lumigauss("export " + shell_quoted(t.run) + " --format ply-3dgs --sh-degree 4 --light " + light +
