@@ -2,7 +2,8 @@
 # The main job on a bundled default: installs dependencies, builds, generates the synthetic demo scene
 # (photos under many lightings, COLMAP model, masks, ground truth), renders its ground-truth surfels, and
 # trains a relightable model on it with the `fast` preset (about 3 minutes on 2 cores), scores it on the test
-# photos under their true lighting (gt-env), and relights it under another sky, turning the sky around.
+# photos under their true lighting (gt-env), relights it under another sky, turning the sky around, and writes
+# the model as a web page that relights in any browser.
 #   scripts/demo.sh [output folder, default: demo]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -30,6 +31,8 @@ sky=$(ls "$out/scene/env/"*_sh.txt | head -n 1)
 "$bin" render "$out/run" --scene "$out/scene" --cameras test --light "$sky" --match-exposure --spin 8 \
     --background sky \
     -o "$out/relit"
+# The model and its lights in one web page that relights in any browser (no lumigauss needed to open it).
+"$bin" export "$out/run" --format html -o "$out/model.html"
 
 value() { tr ' ' '\n' <<< "$summary" | sed -n "s/^$1=//p"; }
 echo
@@ -50,3 +53,4 @@ echo "  $out/run/previews/        photo | shadowed | unshadowed render under the
 echo "  $out/run/progress.html    the run's loss, PSNR and surfel plots and its previews at every checkpoint"
 echo "  $out/eval/                report.md, metrics.json and contact sheets of the test photos"
 echo "  $out/relit/               the test views relit (shadowed, unshadowed, shadow, albedo, normals, ...) per sky turn"
+echo "  $out/model.html           the model in a web page: open it in a browser to orbit and relight it"
