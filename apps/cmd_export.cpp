@@ -26,6 +26,7 @@
 #include "lumigauss/export/splat_format.h"
 #include "lumigauss/export/spz_format.h"
 #include "lumigauss/export/two_sided_sh.h"
+#include "lumigauss/export/world_turn.h"
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_source.h"
@@ -45,6 +46,8 @@ struct ExportOptions {
     int sh_degree = 3;
     bool sh_degree_given = false;
     std::vector<std::string> bake_options_given;  // options that only shape a baked light
+    std::string orient = "none";
+    bool orient_given = false;
     int threads = 0;
     bool quiet = false;
 };
@@ -89,6 +92,10 @@ void run_export(const ExportOptions& o) {
         throw Error(o.bake_options_given.front() + " shapes a baked light (ply-3dgs, spz, splat); " +
                     o.format + " bakes none" +
                     (o.format == "html" ? " (the page has rotation and exposure sliders)" : ""));
+    const ExportOrientation orientation = parse_export_orientation(o.orient);
+    if (o.orient_given && o.format != "ply-3dgs" && o.format != "splat")
+        throw Error("--orient is for --format ply-3dgs and splat (" + o.format +
+                    (o.format == "spz" ? " is always y-up)" : " keeps the world's frame)"));
     if (o.sh_degree < 0 || o.sh_degree > 3)
         throw Error("--sh-degree " + std::to_string(o.sh_degree) + ": use 0, 1, 2 or 3");
 
@@ -107,11 +114,19 @@ void run_export(const ExportOptions& o) {
         const SurfelSides sides = bake_surfel_sides(run.model, env.cast<float>(), shading);
         make_parent(o.out);
         std::string how;
+        // --orient: the world turned for the viewer; the colours are computed in the turned frame.
+        const TurnedWorld world =
+            turn_world(run.model, run.photo_centres, orientation_rotation(orientation, up));
+        const std::string turn = orientation == ExportOrientation::None
+                                     ? ""
+                                     : "; turned so that up " + up_axis_name(up) + " is " +
+                                           (orientation == ExportOrientation::YUp ? "+y" : "-y");
         if (o.format == "ply-3dgs") {
-            write_3dgs_ply(o.out, run.model,
-                           two_sided_view_sh(run.model, sides, o.sh_degree, run.photo_centres), o.sh_degree);
-            how = o.sh_degree > 0 ? "both sides, SH degree " + std::to_string(o.sh_degree)
-                                  : std::string("one colour: ") + seen_side_note(run);
+            write_3dgs_ply(o.out, world.model,
+                           two_sided_view_sh(world.model, sides, o.sh_degree, world.cameras), o.sh_degree);
+            how = (o.sh_degree > 0 ? "both sides, SH degree " + std::to_string(o.sh_degree)
+                                   : std::string("one colour: ") + seen_side_note(run)) +
+                  turn;
         } else if (o.format == "spz") {
             write_spz_file(o.out, run.model, sides, o.sh_degree, up, run.photo_centres);
             how = (o.sh_degree > 0 ? "both sides, SH degree " + std::to_string(o.sh_degree)
@@ -119,8 +134,8 @@ void run_export(const ExportOptions& o) {
                   "; turned so that up " + up_axis_name(up) + " is +y";
         } else {
             write_splat_file(
-                o.out, splat_records(run.model, seen_side_colours(run.model, sides, run.photo_centres)));
-            how = std::string("one colour: ") + seen_side_note(run);
+                o.out, splat_records(world.model, seen_side_colours(world.model, sides, world.cameras)));
+            how = std::string("one colour: ") + seen_side_note(run) + turn;
         }
         if (!o.quiet)
             std::printf("export: %zu surfels baked (%s, %s '%s'; %s) to %s (%s)\n", run.model.size(),
@@ -192,6 +207,16 @@ void register_export(CLI::App& app) {
            "ply-3dgs, spz: degree of the view-dependent colour (0: one colour, the side the training photos "
            "see; 1-3: each side of a surfel shows its own colour; default 3)")
         ->type_name("INT");
+    cmd->add_option_function<std::string>(
+           "--orient",
+           [o](const std::string& orient) {
+               o->orient = orient;
+               o->orient_given = true;
+           },
+           "ply-3dgs, splat: none (default: the world as trained), y-up (--up turned to +y, for y-up viewers "
+           "and engines) or y-down (--up turned to -y: the COLMAP / Inria 3DGS convention most splat viewers "
+           "assume)")
+        ->type_name("TEXT");
     cmd->add_option("--up", o->up,
                     "world up (panorama lights, --rotate, the bundle's up): +z, -y, +y, +x, -x, -z, a vector "
                     "X,Y,Z, or auto (the run's training photos; +z for a bare PLY)")

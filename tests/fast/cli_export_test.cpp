@@ -110,6 +110,14 @@ TEST(CliExport, EveryFormatAndImportFromBarePly) {
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(fs::file_size(tmp / "m.splat"), 32 * surfels);
 
+    // --orient y-down: the same surfels, the world turned for y-down viewers.
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format ply-3dgs --orient y-down --light " +
+                          shell_quoted(photos[0]) + " -o " + shell_quoted(tmp / "baked/turned.ply"),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("is -y"));
+    EXPECT_EQ(load_2dgs_ply(tmp / "baked/turned.ply").size(), surfels);
+
     // spz: gzip; the run's photos' up (the synthetic scene's +z) turned to +y.
     r = run_lumigauss("export " + shell_quoted(t.run) + " --format spz --light " + shell_quoted(photos[0]) +
                           " -o " + shell_quoted(tmp / "m.spz"),
@@ -178,8 +186,20 @@ TEST(CliExport, BadInputNamesTheProblem) {
     EXPECT_THAT(r.output, HasSubstr("--rotate shapes a baked light"));
     EXPECT_FALSE(fs::exists(tmp / "page.html"));
 
-    // --sh-degree: 0..3, and only for ply-3dgs.
     const std::string light = shell_quoted(load_appearance(run_paths(t.run).appearance).at(0));
+    // --orient: none, y-up or y-down, for ply-3dgs and splat (SPZ is y-up by definition).
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format ply-3dgs --orient z-up --light " + light +
+                          " -o " + shell_quoted(tmp / "m.ply"),
+                      tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("--orient 'z-up'"));
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format spz --orient y-down --light " + light +
+                          " -o " + shell_quoted(tmp / "m.spz"),
+                      tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("spz is always y-up"));
+
+    // --sh-degree: 0..3, and only for ply-3dgs.
     r = run_lumigauss("export " + shell_quoted(t.run) + " --format ply-3dgs --sh-degree 4 --light " + light +
                           " -o " + shell_quoted(tmp / "m.ply"),
                       tmp);

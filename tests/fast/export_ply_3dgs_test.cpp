@@ -20,6 +20,7 @@
 #include "lumigauss/export/baked_colours.h"
 #include "lumigauss/export/ply_3dgs.h"
 #include "lumigauss/export/two_sided_sh.h"
+#include "lumigauss/export/world_turn.h"
 #include "lumigauss/math/quaternion.h"
 #include "lumigauss/model/render_model.h"
 #include "lumigauss/render/cpu/rasterizer_cpu.h"
@@ -251,6 +252,31 @@ TEST(ExportPly3dgs, RendersLikeTheModelFromBothSidesShadowed) {
 
 TEST(ExportPly3dgs, RendersLikeTheModelFromBothSidesUnshadowed) {
     expect_two_sided_render(BakeShading::Unshadowed, ShadingMode::Unshadowed);
+}
+
+// `--orient`: a file written in a turned world renders, from the turned cameras, like the model does from the
+// original ones (the two-sided SH computed on the turned normals).
+TEST(ExportPly3dgs, ATurnedFileRendersLikeTheModelFromTurnedCameras) {
+    TempDir tmp("export_3dgs_turned");
+    const GaussianModel model = cube_model(7);
+    const ShCoeffs<float> env = moderate_env();
+    const SurfelSides sides = bake_surfel_sides(model, env, BakeShading::Shadowed);
+    const Mat3d R = orientation_rotation(ExportOrientation::YDown, {0.2, -0.3, 0.9});
+    const TurnedWorld world = turn_world(model, {}, R);
+    write_3dgs_ply(tmp / "turned.ply", world.model, two_sided_view_sh(world.model, sides, 3, world.cameras),
+                   3);
+    const StrictPly ply = read_strict_ply(tmp / "turned.ply");
+    double worst = 1e9;
+    for (Camera cam : ring_cameras()) {
+        const RasterImages<float> ref = render_with_environment(model, cam, env, ShadingMode::Shadowed);
+        cam.rotation = cam.rotation * transpose(R);  // the same view of the turned world
+        RasterState<float> state;
+        worst = std::min(
+            worst,
+            display_psnr(rasterize_forward_cpu(cam, splats_for_view(ply, 3, cam.center()), {}, state).color,
+                         ref.color));
+    }
+    EXPECT_GE(worst, 30.0);
 }
 
 // One colour per surfel (degree 0, .splat): the side the given cameras see, weighted by |cos|; for a single

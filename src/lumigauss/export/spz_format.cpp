@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "lumigauss/export/two_sided_sh.h"
+#include "lumigauss/export/world_turn.h"
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/math/quaternion.h"
 #include "lumigauss/model/view_sh.h"
@@ -72,24 +73,7 @@ std::string gzip(const std::string& data, const std::string& path) {
 }  // namespace
 
 Mat3d rotation_to_y_up(Vec3d up) {
-    const Vec3d u = normalize(up), y{0, 1, 0};
-    const Vec3d axis = cross(u, y);
-    const double s = length(axis), c = dot(u, y);
-    if (s < 1e-12) {
-        if (c > 0) return Mat3d::identity();
-        Mat3d flip = Mat3d::identity();  // 180 degrees about x
-        flip(1, 1) = -1, flip(2, 2) = -1;
-        return flip;
-    }
-    const Vec3d k = axis / s;
-    // Rodrigues: R = I + sin K + (1 - cos) K^2, K the cross-product matrix of k.
-    Mat3d K{};
-    K(0, 1) = -k.z, K(0, 2) = k.y, K(1, 0) = k.z, K(1, 2) = -k.x, K(2, 0) = -k.y, K(2, 1) = k.x;
-    Mat3d R = Mat3d::identity();
-    const Mat3d K2 = K * K;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) R(i, j) += s * K(i, j) + (1 - c) * K2(i, j);
-    return R;
+    return rotation_taking(up, {0, 1, 0});
 }
 
 std::string spz_stream(const SurfelModel& model, const SurfelSides& sides, int sh_degree, Vec3d up,
@@ -97,28 +81,18 @@ std::string spz_stream(const SurfelModel& model, const SurfelSides& sides, int s
     if (sh_degree < 0 || sh_degree > 3)
         throw Error("SPZ: SH degree " + std::to_string(sh_degree) + ": use 0, 1, 2 or 3");
     const std::size_t n = model.size();
-    const Mat3d R = rotation_to_y_up(up);
     // The model and the cameras in SPZ's frame; the view-dependent colours are computed there.
-    SurfelModel turned = model;
-    auto& xyz = turned.param(ModelParam::Xyz);
-    auto& rotation = turned.param(ModelParam::Rotation);
-    for (std::size_t i = 0; i < n; ++i) {
-        const Vec3d p = R * Vec3d{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
-        for (int k = 0; k < 3; ++k) {
-            // The fixed-point value written below (from the float), within 24 signed bits.
-            const double fixed = std::round(double(float(p[k])) * (1 << kSpzFractionalBits));
-            if (!(std::abs(fixed) < double(1 << 23)))
-                throw Error("SPZ: surfel " + std::to_string(i) + " lies " + std::to_string(std::abs(p[k])) +
-                            " units from the origin: SPZ's 24-bit positions hold less than 2048");
-            xyz[3 * i + std::size_t(k)] = float(p[k]);
-        }
-        const Vec4<double> q =
-            quaternion_from_rotation(R * rotation_from_unit_quaternion(to_double(model.unit_quaternion(i))));
-        for (int k = 0; k < 4; ++k) rotation[4 * i + std::size_t(k)] = float(q[k]);
+    const TurnedWorld world = turn_world(model, cameras, rotation_to_y_up(up));
+    const SurfelModel& turned = world.model;
+    const auto& xyz = turned.param(ModelParam::Xyz);
+    for (std::size_t i = 0; i < 3 * n; ++i) {
+        // The fixed-point value written below, within 24 signed bits.
+        const double fixed = std::round(double(xyz[i]) * (1 << kSpzFractionalBits));
+        if (!(std::abs(fixed) < double(1 << 23)))
+            throw Error("SPZ: surfel " + std::to_string(i / 3) + " lies " + std::to_string(std::abs(xyz[i])) +
+                        " units from the origin: SPZ's 24-bit positions hold less than 2048");
     }
-    std::vector<Vec3d> turned_cameras;
-    for (const Vec3d& c : cameras) turned_cameras.push_back(R * c);
-    const std::vector<float> sh = two_sided_view_sh(turned, sides, sh_degree, turned_cameras);
+    const std::vector<float> sh = two_sided_view_sh(turned, sides, sh_degree, world.cameras);
     const std::size_t count = std::size_t(view_sh_coefficients(sh_degree));
 
     std::string out;

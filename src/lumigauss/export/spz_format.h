@@ -29,7 +29,7 @@ namespace lumigauss {
 inline constexpr std::uint32_t kSpzMagic = 0x5053474e;
 inline constexpr int kSpzFractionalBits = 12;
 
-// The smallest rotation taking the unit vector `up` to +y (180 degrees about x for -y).
+// The smallest rotation taking `up` to +y (world_turn.h rotation_taking; half a turn about z for -y).
 Mat3d rotation_to_y_up(Vec3d up);
 
 // The uncompressed SPZ stream (header and arrays) of `model` with baked `sides`, turned so that `up` is +y.
