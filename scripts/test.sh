@@ -31,6 +31,8 @@ if [ $asan -eq 1 ]; then
     cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLUMIGAUSS_WERROR=ON -DLUMIGAUSS_SANITIZE=ON \
           -DLUMIGAUSS_BUILD_BENCH=OFF ${LUMIGAUSS_CMAKE_ARGS:-}
     cmake --build build-asan -j "$jobs"
-    (cd build-asan && ctest --output-on-failure -j "$jobs" -L fast) || status=1
+    # The headless-Chromium tests check the page's scripts, which the sanitizers do not see; their server side
+    # is covered under the sanitizers by the other view tests. They run in the release tree only.
+    (cd build-asan && ctest --output-on-failure -j "$jobs" -L fast -E '^CliViewBrowser\.') || status=1
 fi
 exit $status
