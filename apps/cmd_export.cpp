@@ -2,6 +2,8 @@
 // PLY in the official LumiGauss layout) into files other tools open (docs/formats.md):
 //   ply-3dgs         standard 3DGS PLY, colours baked under --light, both sides of each surfel
 //                    in view-dependent SH of --sh-degree (export/ply_3dgs.h, export/two_sided_sh.h)
+//   compressed-ply   PlayCanvas's compressed PLY (SuperSplat), baked like ply-3dgs, 16 bytes per splat and
+//                    one byte per SH value (export/compressed_ply.h)
 //   spz              Niantic's compressed SPZ (v3), baked like ply-3dgs, turned so that --up is +y
 //                    (export/spz_format.h)
 //   splat            the 32-byte-per-splat web format, baked under --light, the side the training photos see
@@ -20,6 +22,7 @@
 #include "commands.h"
 #include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/export/baked_colours.h"
+#include "lumigauss/export/compressed_ply.h"
 #include "lumigauss/export/environment_files.h"
 #include "lumigauss/export/ply_3dgs.h"
 #include "lumigauss/export/relightable_bundle.h"
@@ -53,7 +56,7 @@ struct ExportOptions {
 };
 
 bool baked_format(const std::string& f) {
-    return f == "ply-3dgs" || f == "spz" || f == "splat";
+    return f == "ply-3dgs" || f == "compressed-ply" || f == "spz" || f == "splat";
 }
 
 void make_parent(const std::string& path) {
@@ -73,7 +76,8 @@ void run_export(const ExportOptions& o) {
         threads =
             std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, o.threads);
     if (!baked_format(o.format) && o.format != "ply-relightable" && o.format != "env" && o.format != "html")
-        throw Error("--format '" + o.format + "': use ply-3dgs, spz, splat, ply-relightable, env or html");
+        throw Error("--format '" + o.format +
+                    "': use ply-3dgs, compressed-ply, spz, splat, ply-relightable, env or html");
     if (o.source.empty() == o.ply.empty())
         throw Error("export: give either a training run folder (or relightable .ply) or --ply FILE");
     const std::string source = o.source.empty() ? o.ply : o.source;
@@ -82,19 +86,21 @@ void run_export(const ExportOptions& o) {
     const bool baked = baked_format(o.format);
     if (baked && o.light.empty()) throw Error("--format " + o.format + " bakes colours: give --light");
     if (!baked && o.format != "html" && !o.light.empty())
-        throw Error("--light is for the baked formats (ply-3dgs, spz, splat) and html, not " + o.format);
+        throw Error("--light is for the baked formats (ply-3dgs, compressed-ply, spz, splat) and html, not " +
+                    o.format);
     const BakeShading shading = parse_bake_shading(o.shading);
-    if (o.sh_degree_given && o.format != "ply-3dgs" && o.format != "spz")
-        throw Error("--sh-degree is for --format ply-3dgs and spz (" + o.format +
+    if (o.sh_degree_given && o.format != "ply-3dgs" && o.format != "compressed-ply" && o.format != "spz")
+        throw Error("--sh-degree is for --format ply-3dgs, compressed-ply and spz (" + o.format +
                     " holds no view-dependent colour)");
     // The page relights in the browser (rotation and exposure are its sliders): nothing is baked into it.
     if (!baked && !o.bake_options_given.empty())
-        throw Error(o.bake_options_given.front() + " shapes a baked light (ply-3dgs, spz, splat); " +
-                    o.format + " bakes none" +
+        throw Error(o.bake_options_given.front() +
+                    " shapes a baked light (ply-3dgs, compressed-ply, spz, splat); " + o.format +
+                    " bakes none" +
                     (o.format == "html" ? " (the page has rotation and exposure sliders)" : ""));
     const ExportOrientation orientation = parse_export_orientation(o.orient);
-    if (o.orient_given && o.format != "ply-3dgs" && o.format != "splat")
-        throw Error("--orient is for --format ply-3dgs and splat (" + o.format +
+    if (o.orient_given && o.format != "ply-3dgs" && o.format != "compressed-ply" && o.format != "splat")
+        throw Error("--orient is for --format ply-3dgs, compressed-ply and splat (" + o.format +
                     (o.format == "spz" ? " is always y-up)" : " keeps the world's frame)"));
     if (o.sh_degree < 0 || o.sh_degree > 3)
         throw Error("--sh-degree " + std::to_string(o.sh_degree) + ": use 0, 1, 2 or 3");
@@ -121,9 +127,13 @@ void run_export(const ExportOptions& o) {
                                      ? ""
                                      : "; turned so that up " + up_axis_name(up) + " is " +
                                            (orientation == ExportOrientation::YUp ? "+y" : "-y");
-        if (o.format == "ply-3dgs") {
-            write_3dgs_ply(o.out, world.model,
-                           two_sided_view_sh(world.model, sides, o.sh_degree, world.cameras), o.sh_degree);
+        if (o.format == "ply-3dgs" || o.format == "compressed-ply") {
+            const std::vector<float> view_sh =
+                two_sided_view_sh(world.model, sides, o.sh_degree, world.cameras);
+            if (o.format == "ply-3dgs")
+                write_3dgs_ply(o.out, world.model, view_sh, o.sh_degree);
+            else
+                write_compressed_ply(o.out, world.model, view_sh, o.sh_degree);
             how = (o.sh_degree > 0 ? "both sides, SH degree " + std::to_string(o.sh_degree)
                                    : std::string("one colour: ") + seen_side_note(run)) +
                   turn;
@@ -178,23 +188,26 @@ void register_export(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "export",
         "Export a trained run (or a relightable .ply of the official LumiGauss code) as a baked 3DGS PLY, a "
-        ".splat, a relightable PLY with its environments, the environments alone, or one self-contained web "
+        "compressed PLY (SuperSplat), an SPZ, a .splat, a relightable PLY with its environments, the "
+        "environments alone, or one self-contained web "
         "page that relights the model in any browser (docs/formats.md)");
     cmd->add_option("source", o->source,
                     "training run folder (model.ply, lighting.lgmlp, appearance.json) or a relightable .ply");
     cmd->add_option("--ply", o->ply,
                     "a bare relightable PLY (official LumiGauss layout) instead of a run: no learned lights, "
                     "use --light with an SH .txt or a panorama");
-    cmd->add_option("--format", o->format, "ply-3dgs, spz, splat, ply-relightable, env or html")->required();
-    cmd->add_option(
-           "-o,--output", o->out,
-           "output file (ply-3dgs, spz, splat, html; ply-relightable: FILE.ply + FILE.environments.json) "
-           "or folder (env)")
+    cmd->add_option("--format", o->format,
+                    "ply-3dgs, compressed-ply, spz, splat, ply-relightable, env or html")
         ->required();
-    cmd->add_option(
-        "--light", o->light,
-        "ply-3dgs/spz/splat: the lighting to bake, as for `render --light` (training photo, SH .txt, "
-        "panorama; prefixes photo:, sh:, pano:); html: one more lighting, offered first");
+    cmd->add_option("-o,--output", o->out,
+                    "output file (ply-3dgs, compressed-ply, spz, splat, html; ply-relightable: FILE.ply + "
+                    "FILE.environments.json) "
+                    "or folder (env)")
+        ->required();
+    cmd->add_option("--light", o->light,
+                    "ply-3dgs/compressed-ply/spz/splat: the lighting to bake, as for `render --light` "
+                    "(training photo, SH .txt, "
+                    "panorama; prefixes photo:, sh:, pano:); html: one more lighting, offered first");
     cmd->add_option("--shading", o->shading,
                     "baked colour: shadowed (the full model: transfer sets) or unshadowed (the normals)")
         ->capture_default_str();
@@ -204,7 +217,8 @@ void register_export(CLI::App& app) {
                o->sh_degree = degree;
                o->sh_degree_given = true;
            },
-           "ply-3dgs, spz: degree of the view-dependent colour (0: one colour, the side the training photos "
+           "ply-3dgs, compressed-ply, spz: degree of the view-dependent colour (0: one colour, the side the "
+           "training photos "
            "see; 1-3: each side of a surfel shows its own colour; default 3)")
         ->type_name("INT");
     cmd->add_option_function<std::string>(
@@ -213,7 +227,8 @@ void register_export(CLI::App& app) {
                o->orient = orient;
                o->orient_given = true;
            },
-           "ply-3dgs, splat: none (default: the world as trained), y-up (--up turned to +y, for y-up viewers "
+           "ply-3dgs, compressed-ply, splat: none (default: the world as trained), y-up (--up turned to +y, "
+           "for y-up viewers "
            "and engines) or y-down (--up turned to -y: the COLMAP / Inria 3DGS convention most splat viewers "
            "assume)")
         ->type_name("TEXT");

@@ -129,6 +129,17 @@ TEST(CliExport, EveryFormatAndImportFromBarePly) {
     EXPECT_EQ(std::uint8_t(spz[0]), 0x1f);
     EXPECT_EQ(std::uint8_t(spz[1]), 0x8b);
 
+    // compressed-ply (export_compressed_ply_test.cpp reads it): degree 1, y-down, 16 + 9 bytes per surfel.
+    r = run_lumigauss("export " + shell_quoted(t.run) +
+                          " --format compressed-ply --sh-degree 1 --orient y-down " + "--light " +
+                          shell_quoted(photos[0]) + " -o " + shell_quoted(tmp / "m.compressed.ply"),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("is -y"));
+    const std::string compressed = synth_test::read_bytes(tmp / "m.compressed.ply");
+    const std::size_t body = compressed.size() - (compressed.find("end_header\n") + 11);
+    EXPECT_EQ(body, 72 * ((surfels + 255) / 256) + (16 + 9) * surfels);
+
     // html: one page holding the viewer, the model (base64) and the run's lights (the browser test opens
     // one).
     r = run_lumigauss(
