@@ -101,6 +101,11 @@ struct TrainConfig {
     bool sky_residual = false;
     double lambda_sky_residual = 0.01;
     double lr_sky_residual = 0.02;
+    // Whether the sky pixels' gradient reaches the lighting. A degree-2 SH cannot draw a sky with a sun (it
+    // saturates where the sun's lobe is, and rings below zero 90 degrees away), so a sky drawn from the light
+    // alone bends each photo's light towards its sky's look. false: the sky's gradient goes to its residual
+    // only (sky_residual), the light is shaped by the surfels' pixels alone.
+    bool sky_pins_light = true;
     // The lighting network's output starts as this uniform radiance (0: as officially, its random bias only),
     // so that the sky and the shading see light from the first iteration (a sky below the radiance floor gets
     // no gradient).

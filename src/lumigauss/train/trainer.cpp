@@ -450,7 +450,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     ShCoeffs<float> g_env{};
     if (c.sky_background) {
         const SkyGrads sky_grads = sky_pixels_backward(s.rays, s.sky, s.g_sky, s.g_sky_radiance, residual);
-        g_env = sky_grads.env;
+        if (c.sky_pins_light) g_env = sky_grads.env;
         if (residual) {
             // L2 penalty: the residual only takes what the lighting cannot hold.
             Sh4Coeffs<float> g_res = sky_grads.residual;
