@@ -4,6 +4,8 @@
 //                    in view-dependent SH of --sh-degree (export/ply_3dgs.h, export/two_sided_sh.h)
 //   compressed-ply   PlayCanvas's compressed PLY (SuperSplat), baked like ply-3dgs, 16 bytes per splat and
 //                    one byte per SH value (export/compressed_ply.h)
+//   glb              binary glTF with KHR_gaussian_splatting, baked like ply-3dgs, turned so that --up is
+//                    +y (export/gltf_splats.h)
 //   spz              Niantic's compressed SPZ (v3), baked like ply-3dgs, turned so that --up is +y
 //                    (export/spz_format.h)
 //   splat            the 32-byte-per-splat web format, baked under --light, the side the training photos see
@@ -24,6 +26,7 @@
 #include "lumigauss/export/baked_colours.h"
 #include "lumigauss/export/compressed_ply.h"
 #include "lumigauss/export/environment_files.h"
+#include "lumigauss/export/gltf_splats.h"
 #include "lumigauss/export/ply_3dgs.h"
 #include "lumigauss/export/relightable_bundle.h"
 #include "lumigauss/export/splat_format.h"
@@ -56,7 +59,7 @@ struct ExportOptions {
 };
 
 bool baked_format(const std::string& f) {
-    return f == "ply-3dgs" || f == "compressed-ply" || f == "spz" || f == "splat";
+    return f == "ply-3dgs" || f == "compressed-ply" || f == "glb" || f == "spz" || f == "splat";
 }
 
 void make_parent(const std::string& path) {
@@ -77,7 +80,7 @@ void run_export(const ExportOptions& o) {
             std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, o.threads);
     if (!baked_format(o.format) && o.format != "ply-relightable" && o.format != "env" && o.format != "html")
         throw Error("--format '" + o.format +
-                    "': use ply-3dgs, compressed-ply, spz, splat, ply-relightable, env or html");
+                    "': use ply-3dgs, compressed-ply, glb, spz, splat, ply-relightable, env or html");
     if (o.source.empty() == o.ply.empty())
         throw Error("export: give either a training run folder (or relightable .ply) or --ply FILE");
     const std::string source = o.source.empty() ? o.ply : o.source;
@@ -86,22 +89,26 @@ void run_export(const ExportOptions& o) {
     const bool baked = baked_format(o.format);
     if (baked && o.light.empty()) throw Error("--format " + o.format + " bakes colours: give --light");
     if (!baked && o.format != "html" && !o.light.empty())
-        throw Error("--light is for the baked formats (ply-3dgs, compressed-ply, spz, splat) and html, not " +
-                    o.format);
+        throw Error(
+            "--light is for the baked formats (ply-3dgs, compressed-ply, glb, spz, splat) and html, not " +
+            o.format);
     const BakeShading shading = parse_bake_shading(o.shading);
-    if (o.sh_degree_given && o.format != "ply-3dgs" && o.format != "compressed-ply" && o.format != "spz")
-        throw Error("--sh-degree is for --format ply-3dgs, compressed-ply and spz (" + o.format +
+    if (o.sh_degree_given && (o.format == "splat" || !baked_format(o.format)))
+        throw Error("--sh-degree is for --format ply-3dgs, compressed-ply, glb and spz (" + o.format +
                     " holds no view-dependent colour)");
     // The page relights in the browser (rotation and exposure are its sliders): nothing is baked into it.
     if (!baked && !o.bake_options_given.empty())
         throw Error(o.bake_options_given.front() +
-                    " shapes a baked light (ply-3dgs, compressed-ply, spz, splat); " + o.format +
+                    " shapes a baked light (ply-3dgs, compressed-ply, glb, spz, splat); " + o.format +
                     " bakes none" +
                     (o.format == "html" ? " (the page has rotation and exposure sliders)" : ""));
-    const ExportOrientation orientation = parse_export_orientation(o.orient);
+    // glTF is y-up by definition, as SPZ is.
+    const ExportOrientation orientation =
+        o.format == "glb" ? ExportOrientation::YUp : parse_export_orientation(o.orient);
     if (o.orient_given && o.format != "ply-3dgs" && o.format != "compressed-ply" && o.format != "splat")
-        throw Error("--orient is for --format ply-3dgs, compressed-ply and splat (" + o.format +
-                    (o.format == "spz" ? " is always y-up)" : " keeps the world's frame)"));
+        throw Error(
+            "--orient is for --format ply-3dgs, compressed-ply and splat (" + o.format +
+            (o.format == "spz" || o.format == "glb" ? " is always y-up)" : " keeps the world's frame)"));
     if (o.sh_degree < 0 || o.sh_degree > 3)
         throw Error("--sh-degree " + std::to_string(o.sh_degree) + ": use 0, 1, 2 or 3");
 
@@ -127,13 +134,15 @@ void run_export(const ExportOptions& o) {
                                      ? ""
                                      : "; turned so that up " + up_axis_name(up) + " is " +
                                            (orientation == ExportOrientation::YUp ? "+y" : "-y");
-        if (o.format == "ply-3dgs" || o.format == "compressed-ply") {
+        if (o.format == "ply-3dgs" || o.format == "compressed-ply" || o.format == "glb") {
             const std::vector<float> view_sh =
                 two_sided_view_sh(world.model, sides, o.sh_degree, world.cameras);
             if (o.format == "ply-3dgs")
                 write_3dgs_ply(o.out, world.model, view_sh, o.sh_degree);
-            else
+            else if (o.format == "compressed-ply")
                 write_compressed_ply(o.out, world.model, view_sh, o.sh_degree);
+            else
+                write_gltf_splats(o.out, world.model, view_sh, o.sh_degree);
             how = (o.sh_degree > 0 ? "both sides, SH degree " + std::to_string(o.sh_degree)
                                    : std::string("one colour: ") + seen_side_note(run)) +
                   turn;
@@ -188,7 +197,8 @@ void register_export(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "export",
         "Export a trained run (or a relightable .ply of the official LumiGauss code) as a baked 3DGS PLY, a "
-        "compressed PLY (SuperSplat), an SPZ, a .splat, a relightable PLY with its environments, the "
+        "compressed PLY (SuperSplat), a glTF (KHR_gaussian_splatting), an SPZ, a .splat, a relightable PLY "
+        "with its environments, the "
         "environments alone, or one self-contained web "
         "page that relights the model in any browser (docs/formats.md)");
     cmd->add_option("source", o->source,
@@ -197,15 +207,16 @@ void register_export(CLI::App& app) {
                     "a bare relightable PLY (official LumiGauss layout) instead of a run: no learned lights, "
                     "use --light with an SH .txt or a panorama");
     cmd->add_option("--format", o->format,
-                    "ply-3dgs, compressed-ply, spz, splat, ply-relightable, env or html")
+                    "ply-3dgs, compressed-ply, glb, spz, splat, ply-relightable, env or html")
         ->required();
-    cmd->add_option("-o,--output", o->out,
-                    "output file (ply-3dgs, compressed-ply, spz, splat, html; ply-relightable: FILE.ply + "
-                    "FILE.environments.json) "
-                    "or folder (env)")
+    cmd->add_option(
+           "-o,--output", o->out,
+           "output file (ply-3dgs, compressed-ply, glb, spz, splat, html; ply-relightable: FILE.ply + "
+           "FILE.environments.json) "
+           "or folder (env)")
         ->required();
     cmd->add_option("--light", o->light,
-                    "ply-3dgs/compressed-ply/spz/splat: the lighting to bake, as for `render --light` "
+                    "ply-3dgs/compressed-ply/glb/spz/splat: the lighting to bake, as for `render --light` "
                     "(training photo, SH .txt, "
                     "panorama; prefixes photo:, sh:, pano:); html: one more lighting, offered first");
     cmd->add_option("--shading", o->shading,
@@ -217,7 +228,8 @@ void register_export(CLI::App& app) {
                o->sh_degree = degree;
                o->sh_degree_given = true;
            },
-           "ply-3dgs, compressed-ply, spz: degree of the view-dependent colour (0: one colour, the side the "
+           "ply-3dgs, compressed-ply, glb, spz: degree of the view-dependent colour (0: one colour, the side "
+           "the "
            "training photos "
            "see; 1-3: each side of a surfel shows its own colour; default 3)")
         ->type_name("INT");

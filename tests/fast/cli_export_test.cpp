@@ -140,6 +140,22 @@ TEST(CliExport, EveryFormatAndImportFromBarePly) {
     const std::size_t body = compressed.size() - (compressed.find("end_header\n") + 11);
     EXPECT_EQ(body, 72 * ((surfels + 255) / 256) + (16 + 9) * surfels);
 
+    // glb (export_gltf_test.cpp reads it): binary glTF, y-up; --orient is refused.
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format glb --sh-degree 2 --light " +
+                          shell_quoted(photos[0]) + " -o " + shell_quoted(tmp / "m.glb"),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("is +y"));
+    const std::string glb = synth_test::read_bytes(tmp / "m.glb");
+    ASSERT_GT(glb.size(), 28u);
+    EXPECT_EQ(glb.substr(0, 4), "glTF");
+    EXPECT_NE(glb.find("KHR_gaussian_splatting:SH_DEGREE_2_COEF_4"), std::string::npos);
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format glb --orient y-down --light " +
+                          shell_quoted(photos[0]) + " -o " + shell_quoted(tmp / "m2.glb"),
+                      tmp);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_THAT(r.output, HasSubstr("glb is always y-up"));
+
     // html: one page holding the viewer, the model (base64) and the run's lights (the browser test opens
     // one).
     r = run_lumigauss(
