@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lumigauss/export/ply_3dgs.h"
+#include "lumigauss/export/two_sided_sh.h"
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/model/view_sh.h"
@@ -95,15 +96,11 @@ std::uint8_t unit_byte(double v) {
 
 std::string gltf_splats_glb(const SurfelModel& model, const std::vector<float>& view_sh, int sh_degree) {
     const std::size_t n = model.size();
-    if (sh_degree < 0 || sh_degree > 3)
-        throw Error("glTF: SH degree " + std::to_string(sh_degree) + " is not 0..3");
     if (n == 0) throw Error("glTF: the model has no surfels");
     if (n > std::size_t(std::numeric_limits<std::uint32_t>::max() / 128))
         throw Error("glTF: " + std::to_string(n) + " surfels do not fit one .glb (4 GiB)");
+    check_view_sh_size(view_sh.size(), n, sh_degree);
     const std::size_t count = std::size_t(view_sh_coefficients(sh_degree));
-    if (view_sh.size() != 3 * count * n)
-        throw Error("glTF: " + std::to_string(view_sh.size()) + " SH values for " + std::to_string(n) +
-                    " surfels of degree " + std::to_string(sh_degree));
     const auto& xyz = model.param(ModelParam::Xyz);
     const auto& logit = model.param(ModelParam::Opacity);
     const auto& log_scale = model.param(ModelParam::Scaling);

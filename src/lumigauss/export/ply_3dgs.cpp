@@ -1,5 +1,6 @@
 #include "lumigauss/export/ply_3dgs.h"
 
+#include "lumigauss/export/two_sided_sh.h"
 #include "lumigauss/io/ply.h"
 #include "lumigauss/model/view_sh.h"
 #include "lumigauss/util/error.h"
@@ -18,12 +19,12 @@ std::vector<std::string> ply_3dgs_property_names(int sh_degree) {
 void write_3dgs_ply(const std::string& path, const SurfelModel& model, const std::vector<float>& view_sh,
                     int sh_degree) {
     const std::size_t n = model.size();
-    if (sh_degree < 0 || sh_degree > 3)
-        fail_in_file(path, "internal: SH degree " + std::to_string(sh_degree) + " is not 0..3");
+    try {
+        check_view_sh_size(view_sh.size(), n, sh_degree);
+    } catch (const Error& e) {
+        fail_in_file(path, std::string("internal: ") + e.what());
+    }
     const std::size_t count = std::size_t(view_sh_coefficients(sh_degree));
-    if (view_sh.size() != 3 * count * n)
-        fail_in_file(path, "internal: " + std::to_string(view_sh.size()) + " SH values for " +
-                               std::to_string(n) + " surfels of degree " + std::to_string(sh_degree));
     const auto& xyz = model.param(ModelParam::Xyz);
     const auto& op = model.param(ModelParam::Opacity);
     const auto& sc = model.param(ModelParam::Scaling);

@@ -55,4 +55,13 @@ std::vector<float> two_sided_view_sh(const SurfelModel& model, const SurfelSides
     return sh;
 }
 
+void check_view_sh_size(std::size_t values, std::size_t surfels, int degree) {
+    if (degree < 0 || degree > 3) throw Error("SH degree " + std::to_string(degree) + " is not 0..3");
+    const std::size_t expected = 3 * std::size_t(view_sh_coefficients(degree)) * surfels;
+    if (values != expected)
+        throw Error(std::to_string(values) + " SH values for " + std::to_string(surfels) +
+                    " surfels of degree " + std::to_string(degree) + " (" + std::to_string(expected) +
+                    " expected)");
+}
+
 }  // namespace lumigauss

@@ -32,4 +32,8 @@ StepExpansion step_expansion(int degree);
 std::vector<float> two_sided_view_sh(const SurfelModel& model, const SurfelSides& sides, int degree,
                                      std::span<const Vec3d> cameras);
 
+// What every writer of such values checks first: the degree is 0..3 and `values` holds
+// view_sh_coefficients(degree) x 3 per surfel. Throws Error saying which does not hold.
+void check_view_sh_size(std::size_t values, std::size_t surfels, int degree);
+
 }  // namespace lumigauss
