@@ -7,6 +7,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "lumigauss/export/byte_rounding.h"
 #include "lumigauss/export/ply_3dgs.h"
 #include "lumigauss/export/two_sided_sh.h"
 #include "lumigauss/io/atomic_file.h"
@@ -88,10 +89,6 @@ class GlbBuilder {
     Json views_ = Json::array(), accessors_ = Json::array();
 };
 
-std::uint8_t unit_byte(double v) {
-    return std::uint8_t(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
-}
-
 }  // namespace
 
 std::string gltf_splats_glb(const SurfelModel& model, const std::vector<float>& view_sh, int sh_degree) {
@@ -123,9 +120,9 @@ std::string gltf_splats_glb(const SurfelModel& model, const std::vector<float>& 
         opacity[i] = float(1.0 / (1.0 + std::exp(-double(logit[i]))));
         for (std::size_t c = 0; c < 3; ++c) {
             const double display = 0.5 + kShC0 * view_sh[i * count * 3 + c];
-            colour[4 * i + c] = unit_byte(srgb_to_linear(float(std::clamp(display, 0.0, 1.0))));
+            colour[4 * i + c] = rounded_byte(255.0 * srgb_to_linear(float(std::clamp(display, 0.0, 1.0))));
         }
-        colour[4 * i + 3] = unit_byte(opacity[i]);
+        colour[4 * i + 3] = rounded_byte(255.0 * opacity[i]);
     }
     for (std::size_t k = 0; k < 3; ++k)
         if (!std::isfinite(lo[k]) || !std::isfinite(hi[k]))

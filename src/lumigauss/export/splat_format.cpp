@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "lumigauss/export/baked_colours.h"
+#include "lumigauss/export/byte_rounding.h"
 #include "lumigauss/export/ply_3dgs.h"
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/util/error.h"
@@ -18,24 +19,20 @@ void put_float(std::uint8_t* at, float v) {
     for (int b = 0; b < 4; ++b) at[b] = std::uint8_t((bits >> (8 * b)) & 0xffu);
 }
 
-std::uint8_t to_byte(double v) {
-    return std::uint8_t(std::clamp(std::round(v), 0.0, 255.0));
-}
-
 }  // namespace
 
 std::array<std::uint8_t, kSplatBytes> encode_splat(const SplatRecord& s) {
     std::array<std::uint8_t, kSplatBytes> out{};
     for (int k = 0; k < 3; ++k) put_float(&out[std::size_t(4 * k)], s.position[k]);
     for (int k = 0; k < 3; ++k) put_float(&out[std::size_t(12 + 4 * k)], s.scale[k]);
-    for (int c = 0; c < 3; ++c) out[std::size_t(24 + c)] = to_byte(255.0 * double(s.colour[c]));
-    out[27] = to_byte(255.0 * double(s.alpha));
+    for (int c = 0; c < 3; ++c) out[std::size_t(24 + c)] = rounded_byte(255.0 * double(s.colour[c]));
+    out[27] = rounded_byte(255.0 * double(s.alpha));
     double norm = 0;
     for (int k = 0; k < 4; ++k) norm += double(s.rotation[k]) * double(s.rotation[k]);
     norm = std::sqrt(norm);
     for (int k = 0; k < 4; ++k) {
         const double q = norm > 0 ? double(s.rotation[k]) / norm : (k == 0 ? 1.0 : 0.0);
-        out[std::size_t(28 + k)] = to_byte(q * 128.0 + 128.0);
+        out[std::size_t(28 + k)] = rounded_byte(q * 128.0 + 128.0);
     }
     return out;
 }

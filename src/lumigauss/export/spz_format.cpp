@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "lumigauss/export/byte_rounding.h"
 #include "lumigauss/export/two_sided_sh.h"
 #include "lumigauss/export/world_turn.h"
 #include "lumigauss/io/atomic_file.h"
@@ -22,10 +23,6 @@ void put_u32(std::string& out, std::uint32_t v) {
 
 Vec4<double> to_double(Vec4f q) {
     return {q[0], q[1], q[2], q[3]};
-}
-
-std::uint8_t to_byte(double v) {
-    return std::uint8_t(std::clamp(std::round(v), 0.0, 255.0));
 }
 
 // The quaternion (w, x, y, z) as SPZ's smallest three, over the components in x, y, z, w order.
@@ -108,14 +105,14 @@ std::string spz_stream(const SurfelModel& model, const SurfelSides& sides, int s
         for (int b = 0; b < 3; ++b) out += char((std::uint32_t(fixed) >> (8 * b)) & 0xffu);
     }
     const auto& opacity = model.param(ModelParam::Opacity);
-    for (std::size_t i = 0; i < n; ++i) out += char(to_byte(255.0 * sigmoid(opacity[i])));
+    for (std::size_t i = 0; i < n; ++i) out += char(rounded_byte(255.0 * sigmoid(opacity[i])));
     for (std::size_t i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c)
-            out += char(to_byte(255.0 * (0.15 * sh[i * count * 3 + std::size_t(c)] + 0.5)));
+            out += char(rounded_byte(255.0 * (0.15 * sh[i * count * 3 + std::size_t(c)] + 0.5)));
     const auto& scaling = model.param(ModelParam::Scaling);
     for (std::size_t i = 0; i < n; ++i) {
-        out += char(to_byte(16.0 * (scaling[2 * i] + 10.0)));
-        out += char(to_byte(16.0 * (scaling[2 * i + 1] + 10.0)));
+        out += char(rounded_byte(16.0 * (scaling[2 * i] + 10.0)));
+        out += char(rounded_byte(16.0 * (scaling[2 * i + 1] + 10.0)));
         out += char(0);  // the surfel's thin axis: as thin as SPZ goes (e^-10)
     }
     for (std::size_t i = 0; i < n; ++i) {
