@@ -51,6 +51,13 @@ const TinyRun& tiny_run() {
     return r;
 }
 
+// `lumigauss export ARGS` run in `tmp` fails and says `message`.
+void expect_refused(const std::string& args, const std::string& message, const TempDir& tmp) {
+    const CommandResult r = run_lumigauss("export " + args, tmp);
+    EXPECT_NE(r.exit_code, 0) << args;
+    EXPECT_THAT(r.output, HasSubstr(message)) << args;
+}
+
 TEST(CliExport, EveryFormatAndImportFromBarePly) {
     const TinyRun& t = tiny_run();
     ASSERT_TRUE(t.ok) << t.setup_output;
@@ -150,11 +157,9 @@ TEST(CliExport, EveryFormatAndImportFromBarePly) {
     ASSERT_GT(glb.size(), 28u);
     EXPECT_EQ(glb.substr(0, 4), "glTF");
     EXPECT_NE(glb.find("KHR_gaussian_splatting:SH_DEGREE_2_COEF_4"), std::string::npos);
-    r = run_lumigauss("export " + shell_quoted(t.run) + " --format glb --orient y-down --light " +
-                          shell_quoted(photos[0]) + " -o " + shell_quoted(tmp / "m2.glb"),
-                      tmp);
-    EXPECT_NE(r.exit_code, 0);
-    EXPECT_THAT(r.output, HasSubstr("glb is always y-up"));
+    expect_refused(shell_quoted(t.run) + " --format glb --orient y-down --light " + shell_quoted(photos[0]) +
+                       " -o " + shell_quoted(tmp / "m2.glb"),
+                   "glb is always y-up", tmp);
 
     // html: one page holding the viewer, the model (base64) and the run's lights (the browser test opens
     // one).
@@ -189,63 +194,43 @@ TEST(CliExport, BadInputNamesTheProblem) {
     EXPECT_THAT(r.output, HasSubstr("--format 'obj'"));
 
     const std::string missing = tmp / "no_such_run";
-    r = run_lumigauss("export " + shell_quoted(missing) + " --format env -o " + shell_quoted(tmp / "e"), tmp);
-    EXPECT_NE(r.exit_code, 0);
-    EXPECT_THAT(r.output, HasSubstr(missing));
+    expect_refused(shell_quoted(missing) + " --format env -o " + shell_quoted(tmp / "e"), missing, tmp);
 
-    r = run_lumigauss("export " + shell_quoted(t.run) + " --format splat -o " + shell_quoted(tmp / "m.splat"),
-                      tmp);
-    EXPECT_NE(r.exit_code, 0);
-    EXPECT_THAT(r.output, HasSubstr("--light"));
+    expect_refused(shell_quoted(t.run) + " --format splat -o " + shell_quoted(tmp / "m.splat"), "--light",
+                   tmp);
 
-    r = run_lumigauss("export " + shell_quoted(t.run) + " --format ply-3dgs --light " +
-                          shell_quoted(tmp / "nope.txt") + " -o " + shell_quoted(tmp / "m.ply"),
-                      tmp);
-    EXPECT_NE(r.exit_code, 0);
-    EXPECT_THAT(r.output, HasSubstr("nope.txt"));
+    expect_refused(shell_quoted(t.run) + " --format ply-3dgs --light " + shell_quoted(tmp / "nope.txt") +
+                       " -o " + shell_quoted(tmp / "m.ply"),
+                   "nope.txt", tmp);
     EXPECT_FALSE(fs::exists(tmp / "m.ply"));
 
     // A baked light's options on a format that bakes none are refused, not ignored.
-    r = run_lumigauss(
-        "export " + shell_quoted(t.run) + " --format html --rotate 30 -o " + shell_quoted(tmp / "page.html"),
-        tmp);
-    EXPECT_NE(r.exit_code, 0);
-    EXPECT_THAT(r.output, HasSubstr("--rotate shapes a baked light"));
+    expect_refused(shell_quoted(t.run) + " --format html --rotate 30 -o " + shell_quoted(tmp / "page.html"),
+                   "--rotate shapes a baked light", tmp);
     EXPECT_FALSE(fs::exists(tmp / "page.html"));
 
     const std::string light = shell_quoted(load_appearance(run_paths(t.run).appearance).at(0));
-    // --orient: none, y-up or y-down, for ply-3dgs and splat (SPZ is y-up by definition).
-    r = run_lumigauss("export " + shell_quoted(t.run) + " --format ply-3dgs --orient z-up --light " + light +
-                          " -o " + shell_quoted(tmp / "m.ply"),
-                      tmp);
-    EXPECT_NE(r.exit_code, 0);
-    EXPECT_THAT(r.output, HasSubstr("--orient 'z-up'"));
-    r = run_lumigauss("export " + shell_quoted(t.run) + " --format spz --orient y-down --light " + light +
-                          " -o " + shell_quoted(tmp / "m.spz"),
-                      tmp);
-    EXPECT_NE(r.exit_code, 0);
-    EXPECT_THAT(r.output, HasSubstr("spz is always y-up"));
+    // --orient: none, y-up or y-down, for ply-3dgs, compressed-ply and splat (SPZ and glTF are y-up).
+    expect_refused(shell_quoted(t.run) + " --format ply-3dgs --orient z-up --light " + light + " -o " +
+                       shell_quoted(tmp / "m.ply"),
+                   "--orient 'z-up'", tmp);
+    expect_refused(shell_quoted(t.run) + " --format spz --orient y-down --light " + light + " -o " +
+                       shell_quoted(tmp / "m.spz"),
+                   "spz is always y-up", tmp);
 
-    // --sh-degree: 0..3, and only for ply-3dgs.
-    r = run_lumigauss("export " + shell_quoted(t.run) + " --format ply-3dgs --sh-degree 4 --light " + light +
-                          " -o " + shell_quoted(tmp / "m.ply"),
-                      tmp);
-    EXPECT_NE(r.exit_code, 0);
-    EXPECT_THAT(r.output, HasSubstr("--sh-degree 4"));
-    r = run_lumigauss("export " + shell_quoted(t.run) + " --format splat --sh-degree 1 --light " + light +
-                          " -o " + shell_quoted(tmp / "m.splat"),
-                      tmp);
-    EXPECT_NE(r.exit_code, 0);
-    EXPECT_THAT(r.output, HasSubstr("--sh-degree is for --format ply-3dgs"));
+    // --sh-degree: 0..3, and only for the formats with view-dependent colour.
+    expect_refused(shell_quoted(t.run) + " --format ply-3dgs --sh-degree 4 --light " + light + " -o " +
+                       shell_quoted(tmp / "m.ply"),
+                   "--sh-degree 4", tmp);
+    expect_refused(shell_quoted(t.run) + " --format splat --sh-degree 1 --light " + light + " -o " +
+                       shell_quoted(tmp / "m.splat"),
+                   "--sh-degree is for --format ply-3dgs", tmp);
     EXPECT_FALSE(fs::exists(tmp / "m.ply"));
     EXPECT_FALSE(fs::exists(tmp / "m.splat"));
 
     // A bare PLY has no photos to export.
-    r = run_lumigauss(
-        "export " + shell_quoted(run_paths(t.run).model) + " --format env -o " + shell_quoted(tmp / "e2"),
-        tmp);
-    EXPECT_NE(r.exit_code, 0);
-    EXPECT_THAT(r.output, HasSubstr("no learned environments"));
+    expect_refused(shell_quoted(run_paths(t.run).model) + " --format env -o " + shell_quoted(tmp / "e2"),
+                   "no learned environments", tmp);
 }
 
 }  // namespace

@@ -7,8 +7,6 @@
 #include <limits>
 #include <numeric>
 
-#include "lumigauss/export/ply_3dgs.h"
-#include "lumigauss/export/two_sided_sh.h"
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/model/view_sh.h"
 #include "lumigauss/util/error.h"
@@ -212,36 +210,15 @@ std::string compressed_ply_bytes(std::span<const GaussianSplat> splats, int sh_d
 
 void write_compressed_ply(const std::string& path, const SurfelModel& model,
                           const std::vector<float>& view_sh, int sh_degree) {
-    const std::size_t n = model.size();
-    try {
-        check_view_sh_size(view_sh.size(), n, sh_degree);
-    } catch (const Error& e) {
-        fail_in_file(path, std::string("internal: ") + e.what());
-    }
-    const std::size_t count = std::size_t(view_sh_coefficients(sh_degree));
-    const auto& xyz = model.param(ModelParam::Xyz);
-    const auto& opacity = model.param(ModelParam::Opacity);
-    const auto& scaling = model.param(ModelParam::Scaling);
-    std::vector<Vec3f> positions(n);
-    for (std::size_t i = 0; i < n; ++i) positions[i] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
-    std::vector<GaussianSplat> splats;
-    splats.reserve(n);
-    for (const std::size_t i : morton_order(positions)) {
-        GaussianSplat s;
-        s.position = positions[i];
-        s.log_scale = {scaling[2 * i], scaling[2 * i + 1], kThinLogScale};
-        s.rotation = model.unit_quaternion(i);
-        s.opacity = opacity[i];
-        for (int c = 0; c < 3; ++c) s.dc[c] = view_sh[i * count * 3 + std::size_t(c)];
-        // channel-major, as f_rest of the 3DGS PLY
-        for (int c = 0; c < 3; ++c)
-            for (std::size_t k = 1; k < count; ++k)
-                s.rest.push_back(view_sh[(i * count + k) * 3 + std::size_t(c)]);
-        splats.push_back(std::move(s));
-    }
     std::string bytes;
     try {
-        bytes = compressed_ply_bytes(splats, sh_degree);
+        std::vector<GaussianSplat> splats = gaussian_splats(model, view_sh, sh_degree);
+        std::vector<Vec3f> positions(splats.size());
+        for (std::size_t i = 0; i < splats.size(); ++i) positions[i] = splats[i].position;
+        std::vector<GaussianSplat> sorted;
+        sorted.reserve(splats.size());
+        for (const std::size_t i : morton_order(positions)) sorted.push_back(std::move(splats[i]));
+        bytes = compressed_ply_bytes(sorted, sh_degree);
     } catch (const Error& e) {
         fail_in_file(path, e.what());
     }

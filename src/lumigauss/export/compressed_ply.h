@@ -20,22 +20,13 @@
 #include <string>
 #include <vector>
 
+#include "lumigauss/export/gaussian_splats.h"
 #include "lumigauss/math/vec.h"
 #include "lumigauss/model/surfel_model.h"
 
 namespace lumigauss {
 
 inline constexpr std::size_t kCompressedChunkSize = 256;
-
-// One Gaussian as the standard 3DGS PLY holds it.
-struct GaussianSplat {
-    Vec3f position;
-    Vec3f log_scale;
-    Vec4f rotation;           // w x y z, any length
-    float opacity = 0;        // logit
-    Vec3f dc;                 // f_dc_0..2
-    std::vector<float> rest;  // f_rest_*, channel-major: 3 x ((degree + 1)^2 - 1)
-};
 
 // The order that sorts `positions` by their 30-bit Morton code in the points' bounding box (stable; the
 // input order where the bounds are degenerate or not finite).
@@ -45,7 +36,7 @@ std::vector<std::size_t> morton_order(std::span<const Vec3f> positions);
 // `rest` does not hold 3 x ((sh_degree + 1)^2 - 1) values, or the degree is not 0..3.
 std::string compressed_ply_bytes(std::span<const GaussianSplat> splats, int sh_degree);
 
-// The surfels as 3DGS splats (the thin third axis of export/ply_3dgs.h), with `view_sh` as in
+// The surfels as 3DGS splats (export/gaussian_splats.h), with `view_sh` as in
 // write_3dgs_ply, in Morton order, written atomically to `path`.
 void write_compressed_ply(const std::string& path, const SurfelModel& model,
                           const std::vector<float>& view_sh, int sh_degree);

@@ -8,8 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lumigauss/export/byte_rounding.h"
-#include "lumigauss/export/ply_3dgs.h"
-#include "lumigauss/export/two_sided_sh.h"
+#include "lumigauss/export/gaussian_splats.h"
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/model/view_sh.h"
@@ -96,31 +95,30 @@ std::string gltf_splats_glb(const SurfelModel& model, const std::vector<float>& 
     if (n == 0) throw Error("glTF: the model has no surfels");
     if (n > std::size_t(std::numeric_limits<std::uint32_t>::max() / 128))
         throw Error("glTF: " + std::to_string(n) + " surfels do not fit one .glb (4 GiB)");
-    check_view_sh_size(view_sh.size(), n, sh_degree);
-    const std::size_t count = std::size_t(view_sh_coefficients(sh_degree));
-    const auto& xyz = model.param(ModelParam::Xyz);
-    const auto& logit = model.param(ModelParam::Opacity);
-    const auto& log_scale = model.param(ModelParam::Scaling);
+    const std::vector<GaussianSplat> splats = gaussian_splats(model, view_sh, sh_degree);
+    const std::size_t rest = 3 * std::size_t(view_sh_coefficients(sh_degree) - 1);
 
     std::vector<float> position(3 * n), rotation(4 * n), scale(3 * n), opacity(n);
     std::vector<std::uint8_t> colour(4 * n);
     std::vector<double> lo(3, std::numeric_limits<double>::infinity()),
         hi(3, -std::numeric_limits<double>::infinity());
     for (std::size_t i = 0; i < n; ++i) {
+        const GaussianSplat& s = splats[i];
         for (std::size_t k = 0; k < 3; ++k) {
-            position[3 * i + k] = xyz[3 * i + k];
-            lo[k] = std::min(lo[k], double(xyz[3 * i + k]));
-            hi[k] = std::max(hi[k], double(xyz[3 * i + k]));
+            position[3 * i + k] = s.position[int(k)];
+            lo[k] = std::min(lo[k], double(s.position[int(k)]));
+            hi[k] = std::max(hi[k], double(s.position[int(k)]));
         }
-        const Vec4f q = model.unit_quaternion(i);  // w x y z
-        for (std::size_t k = 0; k < 4; ++k) rotation[4 * i + k] = q[int((k + 1) % 4)];
-        scale[3 * i] = std::exp(log_scale[2 * i]);
-        scale[3 * i + 1] = std::exp(log_scale[2 * i + 1]);
+        for (std::size_t k = 0; k < 4; ++k)
+            rotation[4 * i + k] = s.rotation[int((k + 1) % 4)];  // w x y z -> x y z w
+        scale[3 * i] = std::exp(s.log_scale.x);
+        scale[3 * i + 1] = std::exp(s.log_scale.y);
         scale[3 * i + 2] = kThinScale;
-        opacity[i] = float(1.0 / (1.0 + std::exp(-double(logit[i]))));
-        for (std::size_t c = 0; c < 3; ++c) {
-            const double display = 0.5 + kShC0 * view_sh[i * count * 3 + c];
-            colour[4 * i + c] = rounded_byte(255.0 * srgb_to_linear(float(std::clamp(display, 0.0, 1.0))));
+        opacity[i] = float(1.0 / (1.0 + std::exp(-double(s.opacity))));
+        for (int c = 0; c < 3; ++c) {
+            const double display = 0.5 + kShC0 * s.dc[c];
+            colour[4 * i + std::size_t(c)] =
+                rounded_byte(255.0 * srgb_to_linear(float(std::clamp(display, 0.0, 1.0))));
         }
         colour[4 * i + 3] = rounded_byte(255.0 * opacity[i]);
     }
@@ -141,7 +139,8 @@ std::string gltf_splats_glb(const SurfelModel& model, const std::vector<float>& 
             const std::size_t k = std::size_t(l * l + m);
             std::vector<float> rgb(3 * n);
             for (std::size_t i = 0; i < n; ++i)
-                for (std::size_t c = 0; c < 3; ++c) rgb[3 * i + c] = view_sh[(i * count + k) * 3 + c];
+                for (std::size_t c = 0; c < 3; ++c)
+                    rgb[3 * i + c] = k == 0 ? splats[i].dc[int(c)] : splats[i].rest[c * (rest / 3) + k - 1];
             attributes["KHR_gaussian_splatting:SH_DEGREE_" + std::to_string(l) + "_COEF_" +
                        std::to_string(m)] = b.add_floats(rgb, "VEC3", n);
         }

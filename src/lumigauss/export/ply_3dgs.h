@@ -17,12 +17,10 @@
 #include <string>
 #include <vector>
 
+#include "lumigauss/export/gaussian_splats.h"
 #include "lumigauss/model/surfel_model.h"
 
 namespace lumigauss {
-
-inline constexpr float kThinScale = 1e-6f;           // the third (normal-direction) scale, linear
-inline constexpr float kThinLogScale = -13.815511f;  // log(1e-6)
 
 // The property names above for an SH degree 0..3, in order.
 std::vector<std::string> ply_3dgs_property_names(int sh_degree);
