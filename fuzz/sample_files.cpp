@@ -11,11 +11,16 @@ ColmapModel sample_colmap_model() {
     ColmapModel m;
     m.cameras[1] = {1, "PINHOLE", 64, 48, {60.0, 61.0, 32.0, 24.0}};
     m.cameras[2] = {2, "SIMPLE_PINHOLE", 32, 24, {30.0, 16.0, 12.0}};
-    m.images.push_back({1, "a.png", {1, 0, 0, 0}, {0, 0, 4}, 1});
-    m.images.push_back({2, "b.png", {0.9238795, 0, 0.3826834, 0}, {0.5, 0, 4}, 1});
-    m.images.push_back({3, "c.png", {0.7071068, 0.7071068, 0, 0}, {0, -1, 3}, 2});
+    // Observations and tracks too, so that the seeds reach their parsers: points 0 and 1 are seen twice,
+    // image a.png has a keypoint without a point.
+    m.images.push_back(
+        {1, "a.png", {1, 0, 0, 0}, {0, 0, 4}, 1, {{{32, 24}, 0}, {{40.5, 24}, 1}, {{3, 4}, -1}}});
+    m.images.push_back({2, "b.png", {0.9238795, 0, 0.3826834, 0}, {0.5, 0, 4}, 1, {{{30.25, 23}, 0}}});
+    m.images.push_back({3, "c.png", {0.7071068, 0.7071068, 0, 0}, {0, -1, 3}, 2, {{{16, 12}, 1}}});
     m.point_xyz = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0.5f}, {-1, -1, 1}};
     m.point_rgb = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.5f, 0.5f, 0.5f}};
+    m.point_error = {0.5, 0.25, 0, 0};
+    m.point_tracks = {{{1, 0}, {2, 0}}, {{1, 1}, {3, 0}}, {}, {}};
     return m;
 }
 

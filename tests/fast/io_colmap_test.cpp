@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <map>
 
 #include "fast/io_test_util.h"
 #include "lumigauss/io/colmap.h"
@@ -30,6 +31,19 @@ ColmapModel varied_model() {
         m.point_xyz.push_back({float(i) * 0.1f, -float(i) / 3.0f, 1e-7f * float(i)});
         m.point_rgb.push_back({float(i % 256) / 255.0f, float(255 - i) / 255.0f, 0.0f});
     }
+    // Structure from motion's extras: each point seen by one or two images, and a keypoint without a point.
+    m.point_error.resize(m.point_xyz.size());
+    m.point_tracks.resize(m.point_xyz.size());
+    for (std::size_t p = 0; p < m.point_xyz.size(); ++p) {
+        m.point_error[p] = 0.1 + double(p) / 7.0;
+        for (std::size_t i = 0; i < m.images.size(); ++i) {
+            if ((p + i) % 3 == 0) continue;
+            ColmapImage& im = m.images[i];
+            m.point_tracks[p].push_back({im.id, int(im.observations.size())});
+            im.observations.push_back({{double(p) + 0.123456789, 29.5 - double(i) / 3.0}, std::int64_t(p)});
+        }
+    }
+    m.images[0].observations.push_back({{1.0 / 3.0, 2.0}, -1});
     return m;
 }
 
@@ -42,7 +56,10 @@ void expect_same_model(const ColmapModel& a, const ColmapModel& b) {
         EXPECT_EQ(a.images[i].camera_id, b.images[i].camera_id);
         for (int k = 0; k < 4; ++k) EXPECT_EQ(a.images[i].qvec[k], b.images[i].qvec[k]);
         for (int k = 0; k < 3; ++k) EXPECT_EQ(a.images[i].tvec[k], b.images[i].tvec[k]);
+        EXPECT_EQ(a.images[i].observations, b.images[i].observations) << a.images[i].name;
     }
+    EXPECT_EQ(a.point_error, b.point_error);
+    EXPECT_EQ(a.point_tracks, b.point_tracks);
     ASSERT_EQ(a.point_xyz.size(), b.point_xyz.size());
     ASSERT_EQ(a.point_rgb.size(), b.point_rgb.size());
     for (std::size_t i = 0; i < a.point_xyz.size(); ++i)
@@ -100,6 +117,19 @@ TEST(ColmapIo, ReadsPlazaAndConvertsToBinary) {
     EXPECT_EQ(m.images[0].tvec[2], 52.276270);
     EXPECT_EQ(m.point_xyz[0][0], -4.1671f);
     EXPECT_EQ(m.point_rgb[0][0], 154.0f / 255.0f);
+    // The data's tracks: each point is seen at least twice, and each track element names an observation of
+    // that image which names the point back.
+    ASSERT_EQ(m.point_tracks.size(), m.point_xyz.size());
+    std::map<int, const ColmapImage*> image_by_id;
+    for (const ColmapImage& im : m.images) image_by_id[im.id] = &im;
+    for (std::size_t p = 0; p < m.point_tracks.size(); ++p) {
+        ASSERT_GE(m.point_tracks[p].size(), 2u) << p;
+        for (const ColmapTrackElement& e : m.point_tracks[p]) {
+            const ColmapImage& im = *image_by_id.at(e.image_id);
+            ASSERT_LT(std::size_t(e.observation), im.observations.size());
+            ASSERT_EQ(im.observations[std::size_t(e.observation)].point_index, std::int64_t(p));
+        }
+    }
     TempDir tmp;
     write_colmap_binary(tmp / "bin", m);
     expect_same_model(read_colmap_binary(tmp / "bin"), m);
@@ -116,6 +146,41 @@ TEST(ColmapIo, TextWithoutObservationLineAtEndAndCommentsReads) {
     EXPECT_EQ(m.images[1].name, "b.png");
     EXPECT_EQ(m.cameras.at(1).params, (std::vector<double>{12, 5, 4}));
     EXPECT_EQ(m.point_rgb[0][2], 10.0f / 255.0f);
+    // POINT3D_ID 5 is the first point; 7 is not in points3D (a hand-edited model): it belongs to none.
+    ASSERT_EQ(m.images[0].observations.size(), 2u);
+    EXPECT_EQ(m.images[0].observations[0], (ColmapObservation{{1.5, 2.5}, -1}));
+    EXPECT_EQ(m.images[0].observations[1], (ColmapObservation{{3, 4}, -1}));
+    EXPECT_EQ(m.point_error, std::vector<double>{0.5});
+    EXPECT_EQ(m.point_tracks[0], (std::vector<ColmapTrackElement>{{1, 0}, {2, 1}}));
+}
+
+// Point ids need not be contiguous: observations are tied to points by id on disk, by index in memory, and
+// written back numbered from 1.
+TEST(ColmapIo, ObservationsFollowTheirPointsAcrossIds) {
+    TempDir tmp;
+    test::write_text(tmp / "m/cameras.txt", "1 SIMPLE_PINHOLE 10 8 12 5 4\n");
+    test::write_text(tmp / "m/images.txt", "1 1 0 0 0 0 0 1 1 a.png\n1 1 90 2 2 40\n");
+    test::write_text(tmp / "m/points3D.txt", "40 0 0 1 1 2 3 0.25 1 1\n90 1 0 1 4 5 6 0.5 1 0\n");
+    const ColmapModel m = read_colmap_text(tmp / "m");
+    EXPECT_EQ(m.images[0].observations[0].point_index, 1);
+    EXPECT_EQ(m.images[0].observations[1].point_index, 0);
+    write_colmap_binary(tmp / "b", m);
+    expect_same_model(read_colmap_binary(tmp / "b"), m);
+    write_colmap_text(tmp / "t", m);
+    EXPECT_NE(test::read_text(tmp / "t/images.txt").find("\n1 1 2 2 2 1\n"), std::string::npos);
+}
+
+TEST(ColmapErrors, OptionalArraysOfTheWrongLengthAreNotWritten) {
+    TempDir tmp;
+    ColmapModel m = test::small_model(2, 8, 6);
+    m.point_error = {0.5};
+    expect_error([&] { write_colmap_text(tmp / "t", m); }, {"point_error holds 1 values for 3 points"});
+    m.point_error.clear();
+    m.point_tracks.resize(4);
+    expect_error([&] { write_colmap_binary(tmp / "b", m); }, {"point_tracks holds 4 tracks for 3 points"});
+    m.point_tracks.clear();
+    m.images[1].observations.push_back({{1, 1}, 3});
+    expect_error([&] { write_colmap_text(tmp / "t", m); }, {"img_1.png", "observes point 3 of 3"});
 }
 
 // --- errors: each names the file and the record or line ---
@@ -145,6 +210,24 @@ TEST(ColmapErrors, TruncatedBinary) {
     const std::string points = test::read_text(tmp / "m/points3D.bin");
     test::write_text(tmp / "m/points3D.bin", points.substr(0, 4));
     expect_error([&] { read_colmap_binary(tmp / "m"); }, {"points3D.bin", "truncated"});
+}
+
+// The lengths inside records (an image's observations, a point's track) are checked against the bytes left
+// before anything is allocated for them: 2^40 observations in a 200-byte file must not reach the allocator.
+TEST(ColmapErrors, BinaryLengthsInsideRecordsArePlausible) {
+    TempDir tmp;
+    write_colmap_binary(tmp / "m", test::small_model(1, 8, 6));
+    const std::string images = test::read_text(tmp / "m/images.bin");
+    std::string inflated = images;
+    const std::uint64_t huge = std::uint64_t(1) << 40;
+    std::memcpy(inflated.data() + inflated.size() - 8, &huge, sizeof huge);  // the only image's POINTS2D
+    test::write_text(tmp / "m/images.bin", inflated);
+    expect_error([&] { read_colmap_binary(tmp / "m"); }, {"images.bin", "record 1 of 1", "POINTS2D length"});
+    test::write_text(tmp / "m/images.bin", images);
+    std::string points = test::read_text(tmp / "m/points3D.bin");
+    std::memcpy(points.data() + points.size() - 8, &huge, sizeof huge);  // the last point's track
+    test::write_text(tmp / "m/points3D.bin", points);
+    expect_error([&] { read_colmap_binary(tmp / "m"); }, {"points3D.bin", "record 3 of 3", "TRACK length"});
 }
 
 // cameras.bin stores width and height as uint64: 2^32 + 40 was cast to int and read as 40.

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <unordered_map>
 
 #include "lumigauss/io/colmap_detail.h"
 #include "lumigauss/util/error.h"
@@ -117,6 +118,38 @@ void check_image(const ColmapImage& image, const std::map<int, ColmapCamera>& ca
     if (!cameras.contains(image.camera_id))
         fail_in_file(file, what + ": camera_id " + std::to_string(image.camera_id) +
                                " does not exist in the cameras file");
+}
+
+void index_observed_points(ColmapModel& model, const std::vector<std::uint64_t>& point_ids) {
+    std::unordered_map<std::uint64_t, std::int64_t> index_of;
+    index_of.reserve(point_ids.size());
+    for (std::size_t i = 0; i < point_ids.size(); ++i) index_of.emplace(point_ids[i], std::int64_t(i));
+    for (ColmapImage& image : model.images)
+        for (ColmapObservation& o : image.observations) {
+            if (o.point_index < 0) continue;  // COLMAP writes -1 for a keypoint without a point
+            const auto it = index_of.find(std::uint64_t(o.point_index));
+            o.point_index = it == index_of.end() ? -1 : it->second;
+        }
+}
+
+void check_optional_arrays(const ColmapModel& model, const std::string& dir) {
+    const std::size_t n = model.point_xyz.size();
+    if (!model.point_error.empty() && model.point_error.size() != n)
+        fail_in_file(dir, "point_error holds " + std::to_string(model.point_error.size()) + " values for " +
+                              std::to_string(n) + " points");
+    if (!model.point_tracks.empty() && model.point_tracks.size() != n)
+        fail_in_file(dir, "point_tracks holds " + std::to_string(model.point_tracks.size()) + " tracks for " +
+                              std::to_string(n) + " points");
+    for (const ColmapImage& image : model.images)
+        for (const ColmapObservation& o : image.observations)
+            if (o.point_index >= std::int64_t(n))
+                fail_in_file(dir, "image " + image.name + " observes point " + std::to_string(o.point_index) +
+                                      " of " + std::to_string(n));
+}
+
+const std::vector<ColmapTrackElement>& point_track(const ColmapModel& model, std::size_t i) {
+    static const std::vector<ColmapTrackElement> kNone;
+    return model.point_tracks.empty() ? kNone : model.point_tracks[i];
 }
 
 }  // namespace colmap_detail

@@ -1,7 +1,9 @@
 #pragma once
 // COLMAP sparse models (`sparse/0`), binary and text, as documented in COLMAP's "Output Format" page.
-// The model keeps what LumiGauss needs: cameras, image poses, SfM point positions and colours. 2D
-// observations and point tracks are read (and validated) but not kept; the writers write none.
+// The model holds what a sparse reconstruction holds: cameras, image poses, SfM point positions and colours,
+// and (optional: empty in models made from cameras alone) each image's 2D observations and each point's
+// reprojection error and track, so that a model read and written again is still a valid SfM model.
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -20,12 +22,33 @@ struct ColmapCamera {
     bool operator==(const ColmapCamera&) const = default;
 };
 
+// One 2D observation (a keypoint) of an image. On disk COLMAP names the point by its POINT3D_ID; in memory
+// it is the point's position in ColmapModel's point arrays, so that ids need not be contiguous on disk.
+struct ColmapObservation {
+    Vec2<double> xy{};              // pixels, origin at the top-left corner of the top-left pixel
+    std::int64_t point_index = -1;  // index into the model's points, -1 when it belongs to none
+
+    bool operator==(const ColmapObservation& o) const {
+        return xy.x == o.xy.x && xy.y == o.xy.y && point_index == o.point_index;
+    }
+};
+
+// One element of a point's track: the image (by IMAGE_ID) and the index of the observation in that image's
+// observations (POINT2D_IDX).
+struct ColmapTrackElement {
+    int image_id = 0;
+    int observation = 0;
+
+    bool operator==(const ColmapTrackElement&) const = default;
+};
+
 struct ColmapImage {
     int id = 0;
     std::string name;               // path relative to the images folder
     Vec4<double> qvec{1, 0, 0, 0};  // world-to-camera rotation (w, x, y, z), stored w-first in .x .y .z .w
     Vec3d tvec{};                   // world-to-camera translation
     int camera_id = 0;
+    std::vector<ColmapObservation> observations;  // POINTS2D[]; empty when the model has none
 };
 
 struct ColmapModel {
@@ -33,6 +56,9 @@ struct ColmapModel {
     std::vector<ColmapImage> images;  // in file order
     std::vector<Vec3f> point_xyz;
     std::vector<Vec3f> point_rgb;  // 0..1 (the stored 8-bit colour / 255)
+    // Optional, parallel to point_xyz when not empty (else the writers write an error of 0 and empty tracks).
+    std::vector<double> point_error;                            // RMS reprojection error, pixels
+    std::vector<std::vector<ColmapTrackElement>> point_tracks;  // the observations of each point
 };
 
 // COLMAP's camera models: id, name and number of parameters (-1 / empty / -1 when unknown).
@@ -48,14 +74,16 @@ std::optional<ColmapFormat> find_colmap_format(const std::string& dir);
 
 // Reads `dir`/{cameras,images,points3D}.{bin,txt}. Throws Error naming the file and the record or line for
 // a missing or truncated file, a malformed line, an unknown camera model, a parameter count that does not
-// match the model, a non-finite pose, or an image whose camera id is not in cameras.
+// match the model, a non-finite pose, or an image whose camera id is not in cameras. An observation whose
+// POINT3D_ID is not in points3D (a model edited by hand) reads as belonging to no point.
 ColmapModel read_colmap_binary(const std::string& dir);
 ColmapModel read_colmap_text(const std::string& dir);
 ColmapModel read_colmap(const std::string& dir);  // by find_colmap_format; Error naming `dir` if neither
 
-// Writes the three files into `dir` (created if missing), each atomically. Doubles are written with 17
-// significant digits and floats with 9, so reading back gives identical records; colours are rounded to 8
-// bit.
+// Writes the three files into `dir` (created if missing), each atomically. Numbers are written in the
+// shortest form that reads back to the same value, so reading back gives identical records; colours are
+// rounded to 8 bit. Points are numbered from 1 in order. Throws Error when the optional arrays are neither
+// empty nor as long as point_xyz, or an observation names a point the model does not have.
 void write_colmap_text(const std::string& dir, const ColmapModel& model);
 void write_colmap_binary(const std::string& dir, const ColmapModel& model);
 

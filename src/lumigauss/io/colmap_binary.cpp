@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/io/colmap.h"
@@ -35,17 +36,22 @@ class Reader {
         return value;
     }
 
-    void skip(std::uint64_t bytes) {
-        need(bytes);
-        pos_ += bytes;
-    }
-
     std::string get_cstring() {
         const std::size_t end = data_.find('\0', pos_);
         if (end == std::string::npos) fail("truncated: the file ends inside the image name");
         std::string s = data_.substr(pos_, end - pos_);
         pos_ = end + 1;
         return s;
+    }
+
+    // A length inside a record, of elements of `element_bytes` each: one the rest of the file cannot hold is
+    // caught before anything is allocated for it.
+    std::uint64_t length(std::uint64_t element_bytes, const char* what) {
+        const auto n = get<std::uint64_t>();
+        if (n > remaining() / element_bytes)
+            fail(std::string("truncated: the ") + what + " length " + std::to_string(n) +
+                 " runs past the end of the file");
+        return n;
     }
 
     // The record count at the start of the file. Each record takes at least `min_bytes`, so a count the file
@@ -137,11 +143,14 @@ std::vector<ColmapImage> read_images(const std::string& path, const std::map<int
         for (int k = 0; k < 3; ++k) im.tvec[k] = in.get<double>();
         im.camera_id = int(in.get<std::uint32_t>());
         im.name = in.get_cstring();
-        const auto num_points2d = in.get<std::uint64_t>();
-        // Each observation is x, y (double) and point3D_id (int64); guard the multiplication against
-        // overflow.
-        if (num_points2d > (std::uint64_t(1) << 40)) in.fail("implausible number of 2D points");
-        in.skip(num_points2d * 24);
+        // Each observation is x, y (double) and point3D_id (int64, -1 for none); the ids become point indices
+        // once points3D is read.
+        im.observations.resize(in.length(24, "POINTS2D"));
+        for (ColmapObservation& o : im.observations) {
+            o.xy.x = in.get<double>();
+            o.xy.y = in.get<double>();
+            o.point_index = in.get<std::int64_t>();
+        }
         colmap_detail::check_image(im, cameras, path, in.where());
         images.push_back(std::move(im));
     }
@@ -149,27 +158,35 @@ std::vector<ColmapImage> read_images(const std::string& path, const std::map<int
     return images;
 }
 
-void read_points(const std::string& path, ColmapModel& model) {
+// Appends the points to `model`; returns their POINT3D_IDs in file order.
+std::vector<std::uint64_t> read_points(const std::string& path, ColmapModel& model) {
     Reader in(path);
     const std::uint64_t n = in.count(8 + 3 * 8 + 3 + 8 + 8, "point");
+    std::vector<std::uint64_t> ids;
+    ids.reserve(n);
     model.point_xyz.reserve(n);
     model.point_rgb.reserve(n);
+    model.point_error.reserve(n);
+    model.point_tracks.reserve(n);
     for (std::uint64_t i = 0; i < n; ++i) {
         in.begin_record(i);
-        in.get<std::uint64_t>();  // point id
+        ids.push_back(in.get<std::uint64_t>());
         Vec3f xyz, rgb;
         for (int k = 0; k < 3; ++k) xyz[k] = float(in.get<double>());
         for (int k = 0; k < 3; ++k) rgb[k] = float(in.get<std::uint8_t>()) / 255.0f;
-        in.get<double>();  // reprojection error
-        const auto track_length = in.get<std::uint64_t>();
-        if (track_length > (std::uint64_t(1) << 40)) in.fail("implausible track length");
-        in.skip(track_length * 8);  // (image_id, point2D_idx) as two uint32
+        model.point_error.push_back(in.get<double>());
+        std::vector<ColmapTrackElement>& track = model.point_tracks.emplace_back(in.length(8, "TRACK"));
+        for (ColmapTrackElement& e : track) {  // (image_id, point2D_idx) as two uint32
+            e.image_id = int(in.get<std::uint32_t>());
+            e.observation = int(in.get<std::uint32_t>());
+        }
         if (!std::isfinite(xyz.x) || !std::isfinite(xyz.y) || !std::isfinite(xyz.z))
             in.fail("point position has a NaN or Inf value");
         model.point_xyz.push_back(xyz);
         model.point_rgb.push_back(rgb);
     }
     in.expect_end();
+    return ids;
 }
 
 template <typename T>
@@ -185,11 +202,12 @@ ColmapModel read_colmap_binary(const std::string& dir) {
     ColmapModel model;
     model.cameras = read_cameras(join(dir, "cameras.bin"));
     model.images = read_images(join(dir, "images.bin"), model.cameras);
-    read_points(join(dir, "points3D.bin"), model);
+    colmap_detail::index_observed_points(model, read_points(join(dir, "points3D.bin"), model));
     return model;
 }
 
 void write_colmap_binary(const std::string& dir, const ColmapModel& model) {
+    colmap_detail::check_optional_arrays(model, dir);
     std::filesystem::create_directories(dir);
     std::string cams, ims, pts;
     put<std::uint64_t>(cams, model.cameras.size());
@@ -209,7 +227,12 @@ void write_colmap_binary(const std::string& dir, const ColmapModel& model) {
         for (int k = 0; k < 3; ++k) put<double>(ims, im.tvec[k]);
         put<std::uint32_t>(ims, std::uint32_t(im.camera_id));
         ims.append(im.name.c_str(), im.name.size() + 1);
-        put<std::uint64_t>(ims, 0);  // no 2D observations
+        put<std::uint64_t>(ims, im.observations.size());
+        for (const ColmapObservation& o : im.observations) {
+            put<double>(ims, o.xy.x);
+            put<double>(ims, o.xy.y);
+            put<std::int64_t>(ims, o.point_index < 0 ? -1 : o.point_index + 1);
+        }
     }
     put<std::uint64_t>(pts, model.point_xyz.size());
     for (std::size_t i = 0; i < model.point_xyz.size(); ++i) {
@@ -217,8 +240,13 @@ void write_colmap_binary(const std::string& dir, const ColmapModel& model) {
         for (int k = 0; k < 3; ++k) put<double>(pts, model.point_xyz[i][k]);
         const Vec3f rgb = i < model.point_rgb.size() ? model.point_rgb[i] : Vec3f{};
         for (int k = 0; k < 3; ++k) put<std::uint8_t>(pts, colmap_detail::colour_byte(rgb[k]));
-        put<double>(pts, 0.0);       // reprojection error
-        put<std::uint64_t>(pts, 0);  // empty track
+        put<double>(pts, colmap_detail::point_error(model, i));
+        const std::vector<ColmapTrackElement>& track = colmap_detail::point_track(model, i);
+        put<std::uint64_t>(pts, track.size());
+        for (const ColmapTrackElement& e : track) {
+            put<std::uint32_t>(pts, std::uint32_t(e.image_id));
+            put<std::uint32_t>(pts, std::uint32_t(e.observation));
+        }
     }
     write_file_atomically(join(dir, "cameras.bin"), cams);
     write_file_atomically(join(dir, "images.bin"), ims);

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "lumigauss/io/colmap.h"
 
@@ -26,5 +27,21 @@ inline std::uint8_t colour_byte(float c) {
 
 // Checks that a camera's model is known and has the right number of parameters.
 void check_camera(const ColmapCamera& camera, const std::string& file, const std::string& where);
+
+// After reading: the observations hold the file's POINT3D_IDs in `point_index`; `point_ids` are the ids of
+// the points in the order read. Turns each id into the point's index (-1 for an id points3D does not have).
+void index_observed_points(ColmapModel& model, const std::vector<std::uint64_t>& point_ids);
+
+// Before writing: throws Error naming `dir` when the optional point arrays are neither empty nor as long as
+// point_xyz, or an observation names a point index the model does not have.
+void check_optional_arrays(const ColmapModel& model, const std::string& dir);
+
+// The reprojection error to write for point i (0 when the model has none).
+inline double point_error(const ColmapModel& model, std::size_t i) {
+    return model.point_error.empty() ? 0.0 : model.point_error[i];
+}
+
+// The track to write for point i (empty when the model has none).
+const std::vector<ColmapTrackElement>& point_track(const ColmapModel& model, std::size_t i);
 
 }  // namespace lumigauss::colmap_detail

@@ -140,10 +140,19 @@ ColmapImage parse_image_line(std::string_view line, const Lines& lines) {
     return im;
 }
 
-void check_points2d_line(std::string_view line, const Lines& lines) {
+// The observations line: triples X Y POINT3D_ID (-1 for a keypoint without a point). The ids are turned into
+// point indices once points3D is read.
+std::vector<ColmapObservation> parse_observations_line(std::string_view line, const Lines& lines) {
     const auto t = split(line);
     if (t.size() % 3 != 0) lines.fail("POINTS2D must be triples X Y POINT3D_ID");
-    for (std::string_view token : t) parse<double>(token, lines, "a number");
+    std::vector<ColmapObservation> observations(t.size() / 3);
+    for (std::size_t i = 0; i < observations.size(); ++i) {
+        ColmapObservation& o = observations[i];
+        o.xy.x = parse<double>(t[3 * i], lines, "a number X");
+        o.xy.y = parse<double>(t[3 * i + 1], lines, "a number Y");
+        o.point_index = parse<std::int64_t>(t[3 * i + 2], lines, "an integer POINT3D_ID");
+    }
+    return observations;
 }
 
 std::vector<ColmapImage> read_images(const std::string& path, const std::map<int, ColmapCamera>& cameras) {
@@ -154,19 +163,22 @@ std::vector<ColmapImage> read_images(const std::string& path, const std::map<int
         images.push_back(parse_image_line(line, lines));
         colmap_detail::check_image(images.back(), cameras, path, lines.where());
         // The observations line always follows (empty when the image has none); at the end it may be absent.
-        if (lines.next(line)) check_points2d_line(line, lines);
+        if (lines.next(line)) images.back().observations = parse_observations_line(line, lines);
     }
     lines.check_declared_count(images.size(), "images");
     return images;
 }
 
-void read_points(const std::string& path, ColmapModel& model) {
+// Appends the points to `model`; returns their POINT3D_IDs in file order.
+std::vector<std::uint64_t> read_points(const std::string& path, ColmapModel& model) {
     Lines lines(path);
+    std::vector<std::uint64_t> ids;
     std::string_view line;
     while (lines.next_record(line)) {
         const auto t = split(line);
         if (t.size() < 8 || (t.size() - 8) % 2 != 0)
             lines.fail("expected POINT3D_ID X Y Z R G B ERROR TRACK[] (pairs IMAGE_ID POINT2D_IDX)");
+        ids.push_back(parse<std::uint64_t>(t[0], lines, "an integer POINT3D_ID"));
         Vec3f xyz, rgb;
         for (int k = 0; k < 3; ++k) xyz[k] = float(parse<double>(t[1 + k], lines, "a number"));
         for (int k = 0; k < 3; ++k) {
@@ -178,8 +190,15 @@ void read_points(const std::string& path, ColmapModel& model) {
             lines.fail("point position has a NaN or Inf value");
         model.point_xyz.push_back(xyz);
         model.point_rgb.push_back(rgb);
+        model.point_error.push_back(parse<double>(t[7], lines, "a number ERROR"));
+        std::vector<ColmapTrackElement>& track = model.point_tracks.emplace_back((t.size() - 8) / 2);
+        for (std::size_t k = 0; k < track.size(); ++k) {
+            track[k].image_id = parse<int>(t[8 + 2 * k], lines, "an integer IMAGE_ID");
+            track[k].observation = parse<int>(t[9 + 2 * k], lines, "an integer POINT2D_IDX");
+        }
     }
     lines.check_declared_count(model.point_xyz.size(), "points");
+    return ids;
 }
 
 // Text output: strings as they are, numbers in the shortest form that reads back to the same value.
@@ -212,7 +231,7 @@ std::string cameras_text(const ColmapModel& model) {
     return out;
 }
 
-// Two lines per image; the second (2D observations) is left empty.
+// Two lines per image: the pose, then the 2D observations (empty when the model has none).
 std::string images_text(const ColmapModel& model) {
     std::string out =
         "# Image list with two lines of data per image:\n"
@@ -222,12 +241,18 @@ std::string images_text(const ColmapModel& model) {
         put(out, im.id);
         for (int k = 0; k < 4; ++k) append(out, " ", im.qvec[k]);
         for (int k = 0; k < 3; ++k) append(out, " ", im.tvec[k]);
-        append(out, " ", im.camera_id, " ", im.name, "\n\n");
+        append(out, " ", im.camera_id, " ", im.name, "\n");
+        for (std::size_t i = 0; i < im.observations.size(); ++i) {
+            const ColmapObservation& o = im.observations[i];
+            if (i > 0) put(out, " ");
+            append(out, o.xy.x, " ", o.xy.y, " ", o.point_index < 0 ? std::int64_t(-1) : o.point_index + 1);
+        }
+        put(out, "\n");
     }
     return out;
 }
 
-// Points numbered from 1, reprojection error 0, empty tracks.
+// Points numbered from 1, with their reprojection errors and tracks (0 and empty when the model has none).
 std::string points_text(const ColmapModel& model) {
     std::string out =
         "# 3D point list with one line of data per point:\n"
@@ -238,7 +263,10 @@ std::string points_text(const ColmapModel& model) {
         for (int k = 0; k < 3; ++k) append(out, " ", model.point_xyz[i][k]);
         const Vec3f rgb = i < model.point_rgb.size() ? model.point_rgb[i] : Vec3f{};
         for (int k = 0; k < 3; ++k) append(out, " ", int(colmap_detail::colour_byte(rgb[k])));
-        put(out, " 0\n");
+        append(out, " ", colmap_detail::point_error(model, i));
+        for (const ColmapTrackElement& e : colmap_detail::point_track(model, i))
+            append(out, " ", e.image_id, " ", e.observation);
+        put(out, "\n");
     }
     return out;
 }
@@ -249,11 +277,12 @@ ColmapModel read_colmap_text(const std::string& dir) {
     ColmapModel model;
     model.cameras = read_cameras(join(dir, "cameras.txt"));
     model.images = read_images(join(dir, "images.txt"), model.cameras);
-    read_points(join(dir, "points3D.txt"), model);
+    colmap_detail::index_observed_points(model, read_points(join(dir, "points3D.txt"), model));
     return model;
 }
 
 void write_colmap_text(const std::string& dir, const ColmapModel& model) {
+    colmap_detail::check_optional_arrays(model, dir);
     std::filesystem::create_directories(dir);
     write_file_atomically(join(dir, "cameras.txt"), cameras_text(model));
     write_file_atomically(join(dir, "images.txt"), images_text(model));

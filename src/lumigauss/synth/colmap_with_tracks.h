@@ -1,11 +1,12 @@
 #pragma once
-// COLMAP text model with 2D observations and point tracks, as structure-from-motion would leave it.
-// io/colmap.h's writer keeps cameras, poses and point colours only (what training needs); a synthetic
-// dataset that stands in for real user data must also have valid tracks, so it is written here.
+// The synthetic scene's sparse model as structure from motion would leave it: one PINHOLE camera per photo,
+// the poses, and the sampled points with their 2D observations and tracks (a synthetic dataset stands in for
+// real user data, so its tracks must be valid). Written by io/colmap.h's writers.
 #include <string>
 #include <vector>
 
 #include "lumigauss/io/camera.h"
+#include "lumigauss/io/colmap.h"
 #include "lumigauss/synth/sfm_points.h"
 
 namespace lumigauss::synth {
@@ -17,8 +18,9 @@ struct ColmapView {
     int training_index = -1;  // index into the views of SfmPoint::track, -1 for test photos (no 2D points)
 };
 
-// Writes dir/{cameras,images,points3D}.txt (dir must exist). Point ids are 1-based in the order given.
-void write_colmap_with_tracks(const std::string& dir, const std::vector<ColmapView>& views,
-                              const std::vector<SfmPoint>& points);
+// The model of `views` (in that order) and `points` (in that order, numbered from 1 when written). Each
+// training view observes the points whose tracks name it, in point order.
+ColmapModel colmap_model_with_tracks(const std::vector<ColmapView>& views,
+                                     const std::vector<SfmPoint>& points);
 
 }  // namespace lumigauss::synth

@@ -146,7 +146,7 @@ int write_sparse_model(const SynthOptions& o, const Landmark& landmark, const st
     sampling.ground_radius = 1.3 * farthest_camera(photos, landmark);
     sampling.seed = o.seed;
     const std::vector<SfmPoint> points = sample_sfm_points(landmark, views, sampling);
-    write_colmap_with_tracks(o.output_dir + "/sparse/0", colmap_views, points);
+    write_colmap_text(o.output_dir + "/sparse/0", colmap_model_with_tracks(colmap_views, points));
     return int(points.size());
 }
 
