@@ -1,7 +1,6 @@
 #pragma once
-// The `gt-env` evaluation protocol: a trained run against a scene that ships its true lighting, in the
-// layout of data/plaza (and of what `lumigauss synth` writes): meta.json (per image: name, split, condition,
-// exposure), env/COND_sh.txt (true radiance SH of each condition) and, optionally, gt/{mask,albedo,normal}.
+// The `gt-env` evaluation protocol: a trained run against a scene that ships its true lighting
+// (eval/gt_scene.h: meta.json, env/COND_sh.txt and, optionally, gt/{mask,albedo,normal}).
 //
 // 1. Light scale. The model shades albedo_m * max(E_m, 1e-5)^(1/2.2) (shading/surfel_shading.h), and a photo
 //    is srgb(exposure * rho/pi * E_true) (data/plaza README). Since srgb(x) ~ x^(1/2.2), the fit has a gauge:
@@ -47,106 +46,22 @@
 //    k_c * exposure * true SH ("image-scaled"); the metrics of 3 stay the protocol's headline.
 // Ground-truth images are area-resampled to the evaluated resolution (-r) like the photos.
 #include <array>
-#include <map>
-#include <optional>
 #include <string>
 #include <vector>
 
+#include "lumigauss/eval/gt_scene.h"
+#include "lumigauss/eval/light_scale.h"
+#include "lumigauss/eval/relightable_run.h"
+#include "lumigauss/eval/sheet_panels.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image_metrics.h"
-#include "lumigauss/model/splat_ply.h"
-#include "lumigauss/model/surfel_model.h"
 #include "lumigauss/render/rasterizer.h"
-#include "lumigauss/shading/sh.h"
 #include "lumigauss/shading/sky_image.h"
 
 namespace lumigauss {
 
-// ---- The scene's ground truth ---------------------------------------------------------------------------
-
-struct GtImageMeta {
-    std::string name, split, condition;
-    double exposure = 1.0;
-};
-
-struct GtSceneMeta {
-    std::string root, meta_path;
-    std::vector<GtImageMeta> images;
-    std::map<std::string, std::string>
-        condition_sh;  // condition id -> SH file ("sh" of meta.json conditions)
-
-    const GtImageMeta* find(const std::string& name) const;  // nullptr if absent
-    // The SH file of a condition: meta.json's "sh" entry of it, else env/COND_sh.txt.
-    std::string sh_path(const std::string& condition) const;
-};
-
-// Reads <root>/meta.json. Throws Error naming the file if it is missing or malformed.
-GtSceneMeta load_gt_scene_meta(const std::string& scene_root);
-// The true radiance SH of a condition; throws Error naming the SH file if it is missing or malformed.
-ShCoeffs<double> load_condition_sh(const GtSceneMeta& meta, const std::string& condition);
-
-// ---- The trained run ------------------------------------------------------------------------------------
-
-struct RelightableRun {
-    std::string dir;
-    SurfelModel model;
-    std::vector<std::string> image_names;      // appearance.json, in embedding order
-    std::vector<ShCoeffs<double>> learned_sh;  // the lighting MLP's env_sh(i) of each of them
-    int downscale = 0;                         // config.json "downscale"; 0 if unknown
-    bool sky_background = false;               // trained with the photo's sky behind the surfels
-    SkyHorizon sky_horizon;                    // where that sky ends below the horizon (TrainedRun's)
-};
-
-// A run folder (model.ply, lighting.lgmlp, appearance.json and config.json if present) or a bare relightable
-// PLY (model/trained_run.h's load_run_or_ply: no photos, so no learned lights). Throws Error naming the
-// first missing or malformed file.
-RelightableRun load_relightable_run(const std::string& path);
-
-// A relightable model with the geometry and colour of a 2DGS surfel model (e.g. gt/surfels.ply, whose colour
-// is the linear albedo rho): model albedo = (rho / pi)^(1/2.2), so that with learned SH = exposure * true SH
-// (light scale 1) its unshadowed colour is (exposure rho/pi E)^(1/2.2), the photo up to the sRGB curve; both
-// transfer sets are the cosine lobes of their side's normal (unoccluded: shadowed == unshadowed).
-SurfelModel relightable_from_surfels(const ViewDependentSurfels& surfels);
-
-// ---- Light scale ----------------------------------------------------------------------------------------
-
-// A_l(j)^2, the weight of coefficient j in the irradiance least squares.
-double irradiance_weight(int j);
-
-struct LightScaleFit {
-    double scale = 1.0;              // k
-    double relative_residual = 0.0;  // sqrt(sum w |L - k e T|^2 / sum w |L|^2)
-    std::vector<std::string> names;  // the training photos used
-    std::vector<double> per_photo;   // each photo's own least-squares k_i (diagnostic)
-};
-
-// The global k of (1) above from matched lists. Throws Error when the lists are empty, differ in length, or
-// the true lighting is all zero.
-LightScaleFit fit_light_scale(const std::vector<ShCoeffs<double>>& learned,
-                              const std::vector<ShCoeffs<double>>& truth, const std::vector<double>& exposure,
-                              const std::vector<std::string>& names = {});
-
-// The run's training photos found in meta.json with split "train" and not in `exclude` (evaluate_gt_env
-// passes the test views it evaluates): a test photo never enters the fit. Throws Error naming meta.json
-// when no photo is left. A bare PLY (no photos, no learned lights) has nothing to fit: k = 1, no names.
-LightScaleFit fit_run_light_scale(const RelightableRun& run, const GtSceneMeta& meta,
-                                  const std::vector<std::string>& exclude = {});
-
-// ---- The protocol ---------------------------------------------------------------------------------------
-
 struct AlbedoMetrics {
     double psnr = 0, mse = 0, mae = 0;
-};
-
-// What the contact sheet shows, at the evaluated resolution (3 channels each unless noted).
-struct GtEnvPanels {
-    Image truth, shadowed, unshadowed;  // photo and clamped renders
-    Image albedo;                       // model albedo, gamma domain, scaled and clamped (empty: no gt)
-    Image normal;                       // rendered normals encoded (n + 1)/2, black where nothing rendered
-    Image shadow;                       // 1 channel: the paper's shadow image (relit_render.h), 1 = lit
-    Image mask;                         // 1 channel: the evaluation mask
-    Image gt_albedo, gt_normal;         // gt/albedo^(1/2.2) and gt/normal as stored (empty when absent)
-    Image normal_error;                 // 1 channel: angle / 45 deg on the mask (empty when no gt/normal)
 };
 
 struct GtEnvImageResult {
@@ -168,7 +83,7 @@ struct GtEnvImageResult {
     bool has_albedo = false, has_normal = false;
     AlbedoMetrics albedo, albedo_gamma;
     AngularErrorStats normal;
-    GtEnvPanels panels;
+    SheetPanels panels;
 };
 
 struct GtEnvResult {
@@ -207,15 +122,6 @@ struct GtEnvOptions {
     // Step 8: also fit the light scale per channel on the training images and score the test views under it.
     bool image_light_scale = true;
 };
-
-// Step 8's scale: per channel, the least-squares scale s_c of the shadowed renders of the training photos
-// under exposure * true SH (k = 1) onto the photos, over evaluated, covered (alpha > 0.5), unclipped pixels;
-// k_c = s_c^2.2. Photos named in `exclude` are skipped. Nothing when no pixel is usable (a model that covers
-// none of them).
-std::optional<std::array<double, 3>> fit_image_light_scale(const RelightableRun& run, const Dataset& scene,
-                                                           const GtSceneMeta& meta,
-                                                           const std::vector<std::string>& exclude,
-                                                           RasterBackend backend = RasterBackend::Cpu);
 
 // Runs the protocol on every test view of `scene` (loaded at the resolution to evaluate). Throws Error
 // naming the file for a test photo missing from meta.json, a missing SH file, or an empty evaluation mask.

@@ -50,7 +50,7 @@ HoldoutImageResult evaluate_view(const TrainedRun& run, const Dataset& scene, co
     HoldoutImageResult r;
     r.name = view.name;
     const int w = view.camera.width, h = view.camera.height;
-    GtEnvPanels& p = r.panels;
+    SheetPanels& p = r.panels;
     p.truth = scene.load_image(view);
     const Image scene_mask = scene.load_mask(view);
     const Image fit_mask = holdout_fit_mask(scene_mask, w, h);
@@ -86,7 +86,7 @@ HoldoutImageResult evaluate_view(const TrainedRun& run, const Dataset& scene, co
         p.shadow = shadow_image(raster_channels(relit, kRelitIntensityUnshadowed, 3),
                                 raster_channels(relit, kRelitIntensityShadowed, 3));
     } else {
-        p = GtEnvPanels{};
+        p = SheetPanels{};
     }
     return r;
 }

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "lumigauss/eval/gt_env.h"
+#include "lumigauss/eval/sheet_panels.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/io/image_metrics.h"
@@ -49,9 +49,9 @@ struct HoldoutImageResult {
     ShCoeffs<double> light;             // the environment SH fitted to the shadowed render
     ShCoeffs<double> light_unshadowed;  // ... and to the unshadowed one
     ImageMetrics shadowed, unshadowed;  // on the right half
-    // The contact sheet's panels (report.h's SheetPanels): photo, clamped renders under their fitted lights,
+    // The contact sheet's panels (eval/sheet_panels.h): photo, clamped renders under their fitted lights,
     // albedo (clamped), normals, shadow image, and as `mask` the score mask. No ground-truth panels.
-    GtEnvPanels panels;
+    SheetPanels panels;
 };
 
 struct HoldoutResult {

@@ -37,9 +37,6 @@ struct ReportSources {
 
 // ---- Shared by the protocols -----------------------------------------------------------------------------
 
-// The panels of one contact sheet (layout above), whichever protocol fills them.
-using SheetPanels = GtEnvPanels;
-
 // sheets/<image name without extension>.png (folders in the name kept), relative to the report folder.
 std::string sheet_relative_path(const std::string& image_name);
 // The two-row contact sheet (3 channels; empty panels are drawn black; 1-channel panels grey).

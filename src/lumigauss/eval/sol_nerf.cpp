@@ -70,7 +70,7 @@ void score_best_angle(RelitRenderer& renderer, const View& view, const SsimOptio
     const auto t0 = Clock::now();
     const RasterImages<float>& relit = renderer.render(view.camera, r.world_sh.cast<float>());
     r.render_ms = ms_since(t0);
-    GtEnvPanels& p = r.panels;
+    SheetPanels& p = r.panels;
     p.shadowed = clamp01(raster_channels(relit, kRelitShadowed, 3));
     p.unshadowed = clamp01(raster_channels(relit, kRelitUnshadowed, 3));
     r.shadowed = image_metrics(p.shadowed, p.truth, p.mask, ssim);
@@ -104,7 +104,7 @@ SolNerfImageResult evaluate_image(const SolNerfImageConfig& image, const Dataset
     r.projected_sh = env.sh;
     r.boosted_values = env.boosted;
 
-    GtEnvPanels& p = r.panels;
+    SheetPanels& p = r.panels;
     p.truth = scene.load_image(*view);
     p.mask = evaluation_mask(scene, *view, r.mask_path);
     r.mask_pixels = mask_pixels(p.mask);
@@ -180,7 +180,7 @@ SolNerfResult evaluate_sol_nerf(const SurfelModel& model, const Dataset& scene, 
     for (const SolNerfImageConfig& image : config.images) {
         result.images.push_back(evaluate_image(image, scene, config, options, search, final_render));
         result.search_seconds += result.images.back().search_ms / 1e3;
-        if (!options.keep_panels) result.images.back().panels = GtEnvPanels{};
+        if (!options.keep_panels) result.images.back().panels = SheetPanels{};
     }
     const double n = double(result.images.size());
     std::vector<double> render_ms;

@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "lumigauss/eval/gt_env.h"
+#include "lumigauss/eval/sheet_panels.h"
 #include "lumigauss/eval/sol_nerf_config.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image_metrics.h"
@@ -70,7 +70,7 @@ struct SolNerfImageResult {
     ImageMetrics shadowed, unshadowed;
     double search_ms = 0;  // wall time of the search renders
     double render_ms = 0;  // wall time of the final render (shadowed + unshadowed + maps)
-    GtEnvPanels panels;    // photo, renders, albedo, normals, shadow, mask (no ground-truth rows)
+    SheetPanels panels;    // photo, renders, albedo, normals, shadow, mask (no ground-truth rows)
 
     bool best_at_range_edge() const {
         return angles.size() > 2 && (best_index == 0 || best_index + 1 == angles.size());
