@@ -12,6 +12,7 @@
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
 #include "support/run_cli.h"
+#include "support/shared_tiny_run.h"
 #include "synth_test_util.h"
 
 namespace lumigauss {
@@ -24,30 +25,14 @@ using testing::run_lumigauss;
 using testing::shell_quoted;
 namespace fs = std::filesystem;
 
-// The tiny scene and a 50-iteration run on it, made once per test process.
-struct TinyRun {
-    TempDir dir{"cli_eval"};
-    std::string scene = dir / "scene", run = dir / "run";
-    std::string train_output;
-    int train_exit = -1;
-    TinyRun() {
-        synth::generate_synthetic_scene(synth_test::tiny_options(scene));
-        const CommandResult r = run_lumigauss(
-            "train " + shell_quoted(scene) + " -o " + shell_quoted(run) + " --preset fast --iterations 50 -q",
-            dir);
-        train_exit = r.exit_code;
-        train_output = r.output;
-    }
-};
-
-const TinyRun& tiny_run() {
-    static TinyRun r;
-    return r;
+// The tiny scene and a short run on it, shared with the other CLI tests (support/shared_tiny_run.h).
+const testing::SharedTinyRun& tiny_run() {
+    return testing::shared_tiny_run();
 }
 
 TEST(CliEval, WritesMetricsReportAndContactSheets) {
-    const TinyRun& t = tiny_run();
-    ASSERT_EQ(t.train_exit, 0) << t.train_output;
+    const testing::SharedTinyRun& t = tiny_run();
+    ASSERT_EQ(t.exit_code, 0) << t.output;
     TempDir tmp("cli_eval_report");
     const std::string report = tmp / "report";
     const CommandResult r =
@@ -101,8 +86,8 @@ TEST(CliEval, WritesMetricsReportAndContactSheets) {
 
 // The diagnostic on training views scores every training photo, and says so in metrics.json.
 TEST(CliEval, TrainViewsDiagnostic) {
-    const TinyRun& t = tiny_run();
-    ASSERT_EQ(t.train_exit, 0) << t.train_output;
+    const testing::SharedTinyRun& t = tiny_run();
+    ASSERT_EQ(t.exit_code, 0) << t.output;
     TempDir tmp("cli_eval_train_views");
     const std::string report = tmp / "report";
     const CommandResult r =
@@ -121,8 +106,8 @@ TEST(CliEval, TrainViewsDiagnostic) {
 // A bare relightable PLY (e.g. from the official code) is evaluated too: it has no learned lights, so the
 // light scale is 1 and the scores are those of the run's surfels under the true lights.
 TEST(CliEval, BarePlyIsEvaluatedWithLightScaleOne) {
-    const TinyRun& t = tiny_run();
-    ASSERT_EQ(t.train_exit, 0) << t.train_output;
+    const testing::SharedTinyRun& t = tiny_run();
+    ASSERT_EQ(t.exit_code, 0) << t.output;
     TempDir tmp("cli_eval_bare_ply");
     const std::string ply = tmp / "bare.ply";
     fs::copy_file(t.run + "/model.ply", ply);
@@ -137,8 +122,8 @@ TEST(CliEval, BarePlyIsEvaluatedWithLightScaleOne) {
 }
 
 TEST(CliEval, MissingModelIsNamed) {
-    const TinyRun& t = tiny_run();
-    ASSERT_EQ(t.train_exit, 0) << t.train_output;
+    const testing::SharedTinyRun& t = tiny_run();
+    ASSERT_EQ(t.exit_code, 0) << t.output;
     TempDir tmp("cli_eval_no_model");
     const std::string run = tmp / "run";
     fs::create_directories(run);
@@ -153,8 +138,8 @@ TEST(CliEval, MissingModelIsNamed) {
 }
 
 TEST(CliEval, SceneWithoutGroundTruthIsNamed) {
-    const TinyRun& t = tiny_run();
-    ASSERT_EQ(t.train_exit, 0) << t.train_output;
+    const testing::SharedTinyRun& t = tiny_run();
+    ASSERT_EQ(t.exit_code, 0) << t.output;
     TempDir tmp("cli_eval_no_meta");
     const CommandResult r =
         run_lumigauss("eval " + shell_quoted(t.run) + " --scene " + shell_quoted(tmp / "nothing") + " -o " +

@@ -15,6 +15,7 @@
 #include "lumigauss/model/splat_ply.h"
 #include "lumigauss/train/run_folder.h"
 #include "support/run_cli.h"
+#include "support/shared_tiny_run.h"
 #include "synth_test_util.h"
 
 namespace lumigauss {
@@ -27,28 +28,9 @@ using testing::run_lumigauss;
 using testing::shell_quoted;
 namespace fs = std::filesystem;
 
-// A tiny scene and a 30-iteration run on it, made once per test process.
-struct TinyRun {
-    TempDir dir{"cli_export_run"};
-    std::string run = dir / "run";
-    std::string setup_output;
-    bool ok = false;
-    TinyRun() {
-        const std::string scene = dir / "scene";
-        CommandResult r = run_lumigauss("synth --preset tiny -o " + shell_quoted(scene), dir);
-        setup_output = r.output;
-        if (r.exit_code != 0) return;
-        r = run_lumigauss(
-            "train " + shell_quoted(scene) + " -o " + shell_quoted(run) + " --preset fast --iterations 30 -q",
-            dir);
-        setup_output += r.output;
-        ok = r.exit_code == 0;
-    }
-};
-
-const TinyRun& tiny_run() {
-    static TinyRun r;
-    return r;
+// The tiny scene and a short run on it, shared with the other CLI tests (support/shared_tiny_run.h).
+const testing::SharedTinyRun& tiny_run() {
+    return testing::shared_tiny_run();
 }
 
 // `lumigauss export ARGS` run in `tmp` fails and says `message`.
@@ -59,8 +41,8 @@ void expect_refused(const std::string& args, const std::string& message, const T
 }
 
 TEST(CliExport, EveryFormatAndImportFromBarePly) {
-    const TinyRun& t = tiny_run();
-    ASSERT_TRUE(t.ok) << t.setup_output;
+    const testing::SharedTinyRun& t = tiny_run();
+    ASSERT_EQ(t.exit_code, 0) << t.output;
     TempDir tmp("cli_export_formats");
     const std::vector<std::string> photos = load_appearance(run_paths(t.run).appearance);
     ASSERT_FALSE(photos.empty());
@@ -185,8 +167,8 @@ TEST(CliExport, EveryFormatAndImportFromBarePly) {
 }
 
 TEST(CliExport, BadInputNamesTheProblem) {
-    const TinyRun& t = tiny_run();
-    ASSERT_TRUE(t.ok) << t.setup_output;
+    const testing::SharedTinyRun& t = tiny_run();
+    ASSERT_EQ(t.exit_code, 0) << t.output;
     TempDir tmp("cli_export_bad");
     CommandResult r =
         run_lumigauss("export " + shell_quoted(t.run) + " --format obj -o " + shell_quoted(tmp / "x"), tmp);

@@ -26,6 +26,7 @@
 #include "lumigauss/shading/sky_image.h"
 #include "lumigauss/shading/surfel_shading.h"
 #include "support/run_cli.h"
+#include "support/shared_tiny_run.h"
 #include "synth_test_util.h"
 
 namespace lumigauss {
@@ -38,22 +39,9 @@ using testing::run_lumigauss;
 using testing::shell_quoted;
 namespace fs = std::filesystem;
 
-// The tiny scene and a 30-iteration run on it, made once per test process.
-struct TinyRun {
-    TempDir dir{"cli_relight"};
-    std::string scene = dir / "scene", run = dir / "run";
-    CommandResult train;
-    TinyRun() {
-        synth::generate_synthetic_scene(synth_test::tiny_options(scene));
-        train = run_lumigauss(
-            "train " + shell_quoted(scene) + " -o " + shell_quoted(run) + " --preset fast --iterations 30 -q",
-            dir);
-    }
-};
-
-const TinyRun& tiny_run() {
-    static TinyRun r;
-    return r;
+// The tiny scene and a short run on it, shared with the other CLI tests (support/shared_tiny_run.h).
+const testing::SharedTinyRun& tiny_run() {
+    return testing::shared_tiny_run();
 }
 
 std::vector<const View*> test_views(const Dataset& scene) {
@@ -97,8 +85,8 @@ void expect_every_map(const std::string& out, const std::string& stem, int width
 }
 
 TEST(CliRelight, EveryLightKindWritesEveryMapAtTheCameraSize) {
-    const TinyRun& t = tiny_run();
-    ASSERT_EQ(t.train.exit_code, 0) << t.train.output;
+    const testing::SharedTinyRun& t = tiny_run();
+    ASSERT_EQ(t.exit_code, 0) << t.output;
     const Dataset scene = load_dataset(t.scene);
     ASSERT_FALSE(test_views(scene).empty());
     TempDir tmp("cli_relight_kinds");
@@ -135,8 +123,8 @@ TEST(CliRelight, EveryLightKindWritesEveryMapAtTheCameraSize) {
 // (sky_colour.h), a panorama light the panorama itself along the pixel's ray (relit_sky.h); the surfels'
 // pixels (alpha 1) are the plain colour.
 TEST(CliRelight, SkyBackgroundShowsTheLightsSky) {
-    const TinyRun& t = tiny_run();
-    ASSERT_EQ(t.train.exit_code, 0) << t.train.output;
+    const testing::SharedTinyRun& t = tiny_run();
+    ASSERT_EQ(t.exit_code, 0) << t.output;
     const Dataset scene = load_dataset(t.scene);
     const View& view = *test_views(scene).front();
     const std::string stem = fs::path(view.name).stem().string();
@@ -195,8 +183,8 @@ TEST(CliRelight, SkyBackgroundShowsTheLightsSky) {
 }
 
 TEST(CliRelight, PhotoLightRenderIsTheLibraryRender) {
-    const TinyRun& t = tiny_run();
-    ASSERT_EQ(t.train.exit_code, 0) << t.train.output;
+    const testing::SharedTinyRun& t = tiny_run();
+    ASSERT_EQ(t.exit_code, 0) << t.output;
     TempDir tmp("cli_relight_known");
     const std::string out = tmp / "out";
     const CommandResult r =
@@ -230,8 +218,8 @@ TEST(CliRelight, PhotoLightRenderIsTheLibraryRender) {
 }
 
 TEST(CliRelight, SpinWritesNumberedFramesAndAVideo) {
-    const TinyRun& t = tiny_run();
-    ASSERT_EQ(t.train.exit_code, 0) << t.train.output;
+    const testing::SharedTinyRun& t = tiny_run();
+    ASSERT_EQ(t.exit_code, 0) << t.output;
     TempDir tmp("cli_relight_spin");
     const std::string env = fake_ffmpeg_path_env(tmp);
     const std::string out = tmp / "spin";
@@ -281,8 +269,8 @@ TEST(CliRelight, SpinWritesNumberedFramesAndAVideo) {
 }
 
 TEST(CliRelight, OrbitWritesATurntableWhoseCamerasReadBack) {
-    const TinyRun& t = tiny_run();
-    ASSERT_EQ(t.train.exit_code, 0) << t.train.output;
+    const testing::SharedTinyRun& t = tiny_run();
+    ASSERT_EQ(t.exit_code, 0) << t.output;
     TempDir tmp("cli_relight_orbit");
     const std::string env = fake_ffmpeg_path_env(tmp);
     const std::string out = tmp / "orbit";
@@ -315,8 +303,8 @@ TEST(CliRelight, OrbitWritesATurntableWhoseCamerasReadBack) {
 }
 
 TEST(CliRelight, BadInputNamesTheFileAndWritesNothing) {
-    const TinyRun& t = tiny_run();
-    ASSERT_EQ(t.train.exit_code, 0) << t.train.output;
+    const testing::SharedTinyRun& t = tiny_run();
+    ASSERT_EQ(t.exit_code, 0) << t.output;
     TempDir tmp("cli_relight_errors");
     const std::string out = tmp / "out";
     const std::string base = "render " + shell_quoted(t.run) + " --scene " + shell_quoted(t.scene) + " -o " +

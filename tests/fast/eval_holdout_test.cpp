@@ -14,6 +14,7 @@
 #include "lumigauss/util/error.h"
 #include "support/clamped_render.h"
 #include "support/run_cli.h"
+#include "support/shared_tiny_run.h"
 #include "synth_test_util.h"
 
 namespace lumigauss {
@@ -52,19 +53,16 @@ TEST(HoldoutMasks, LeftHalfFitsRightHalfScores) {
     EXPECT_THROW(holdout_fit_mask(Image(9, 8, 1, 1.0f), 10, 8), Error);
 }
 
-// The tiny scene, a short run on it, and a copy of the scene whose test photos are the run's renders.
+// The tiny scene and a short run on it (shared with the CLI tests: support/shared_tiny_run.h), and a copy of
+// the scene whose test photos are the run's renders.
 struct HoldoutScene {
     TempDir dir{"eval_holdout"};
-    std::string scene = dir / "scene", run_dir = dir / "run", copy = dir / "copy";
+    std::string scene = testing::shared_tiny_run().scene, run_dir = testing::shared_tiny_run().run;
+    std::string copy = dir / "copy";
     bool ok = false;
     ShCoeffs<double> light;
     HoldoutScene() {
-        synth::generate_synthetic_scene(synth_test::tiny_options(scene));
-        if (run_lumigauss("train " + shell_quoted(scene) + " -o " + shell_quoted(run_dir) +
-                              " --preset fast --iterations 30 -q",
-                          dir)
-                .exit_code != 0)
-            return;
+        if (testing::shared_tiny_run().exit_code != 0) return;
         fs::copy(scene, copy, fs::copy_options::recursive);
         const TrainedRun run = load_trained_run(run_dir);
         light = run.learned_sh(1);

@@ -37,7 +37,7 @@ inline std::string read_bytes(const std::string& path) {
     return s.str();
 }
 
-// The parts of a COLMAP text model with tracks that io/colmap.h does not keep.
+// A COLMAP text model with tracks read independently of io/colmap.h, to check what its writer wrote.
 struct TrackPoint {
     int id = 0;
     double x = 0, y = 0, z = 0, error = 0;
