@@ -11,6 +11,7 @@
 #include <random>
 
 #include "lumigauss/model/lighting_mlp.h"
+#include "lumigauss/train/lighting_mlp_gradients.h"
 #include "lumigauss/util/error.h"
 #include "support/temp_dir.h"
 
@@ -45,7 +46,8 @@ TEST(TrainMlp, ShapesMatchOfficial) {
     EXPECT_EQ(mlp.param(MlpGroup::kB2).size(), 64u);
     EXPECT_EQ(mlp.param(MlpGroup::kW3).size(), 27u * 64u);
     EXPECT_EQ(mlp.param(MlpGroup::kB3).size(), 27u);
-    for (MlpGroup g : kAllGroups) EXPECT_EQ(mlp.grad(g).size(), mlp.param(g).size());
+    const LightingMlpGradients grads(mlp);
+    for (MlpGroup g : kAllGroups) EXPECT_EQ(grads[g].size(), mlp.param(g).size());
     EXPECT_EQ(LightingMlp::row_width(MlpGroup::kEmbedding), 24);
     EXPECT_EQ(LightingMlp::row_width(MlpGroup::kW2), 1);
 }
@@ -70,8 +72,10 @@ TEST(TrainMlp, InitialisationFollowsPytorchDistributions) {
     const double mean = sum / double(e.size()), var = sum2 / double(e.size()) - mean * mean;
     EXPECT_NEAR(mean, 0.0, 0.05);
     EXPECT_NEAR(std::sqrt(var), 1.0, 0.05);
+    // Fresh gradients are zero.
+    const LightingMlpGradients grads(mlp);
     for (MlpGroup g : kAllGroups)
-        for (float v : mlp.grad(g)) ASSERT_EQ(v, 0.0f);
+        for (float v : grads[g]) ASSERT_EQ(v, 0.0f);
 }
 
 TEST(TrainMlp, SeedIsDeterministicAndFloatMatchesDouble) {
@@ -125,7 +129,8 @@ TEST(TrainMlp, GradientsMatchFiniteDifferences) {
     BasicLightingMlp<double> mlp(3, 17);
     const int image = 1;
     const ShCoeffs<double> g = random_sh(rng);
-    mlp.backward(mlp.forward(image), g);
+    BasicLightingMlpGradients<double> grads(mlp);
+    grads.backward(mlp, mlp.forward(image), g);
 
     const double h = 1e-6;
     int active = 0;
@@ -133,7 +138,7 @@ TEST(TrainMlp, GradientsMatchFiniteDifferences) {
     ASSERT_GT(active, 8);  // enough units pass the ReLU for the check to mean something
     for (MlpGroup grp : kAllGroups) {
         auto& p = mlp.param(grp);
-        const auto& grad = mlp.grad(grp);
+        const auto& grad = grads[grp];
         double max_err = 0;
         for (std::size_t i = 0; i < p.size(); ++i) {
             const double saved = p[i];
@@ -150,25 +155,29 @@ TEST(TrainMlp, GradientsMatchFiniteDifferences) {
         EXPECT_LT(max_err, 1e-4);
     }
     // Only the used embedding row gets gradient (the table's gradient is dense, zeros elsewhere).
-    const auto& ge = mlp.grad(MlpGroup::kEmbedding);
+    const auto& ge = grads[MlpGroup::kEmbedding];
     for (int i = 0; i < 24; ++i) {
         EXPECT_EQ(ge[i], 0.0);
         EXPECT_EQ(ge[2 * 24 + i], 0.0);
     }
 }
 
-TEST(TrainMlp, BackwardAccumulatesUntilZeroGrad) {
+TEST(TrainMlp, BackwardAccumulatesUntilReset) {
     std::mt19937 rng(2);
     BasicLightingMlp<double> mlp(2, 9);
     const ShCoeffs<double> g = random_sh(rng);
     const auto fwd = mlp.forward(0);
-    mlp.backward(fwd, g);
-    const std::vector<double> once = mlp.grad(MlpGroup::kW1);
-    mlp.backward(fwd, g);
-    for (std::size_t i = 0; i < once.size(); ++i) ASSERT_DOUBLE_EQ(mlp.grad(MlpGroup::kW1)[i], 2 * once[i]);
-    mlp.zero_grad();
+    BasicLightingMlpGradients<double> grads(mlp);
+    grads.backward(mlp, fwd, g);
+    const std::vector<double> once = grads[MlpGroup::kW1];
+    grads.backward(mlp, fwd, g);
+    for (std::size_t i = 0; i < once.size(); ++i) ASSERT_DOUBLE_EQ(grads[MlpGroup::kW1][i], 2 * once[i]);
+    grads.reset(mlp);
     for (MlpGroup grp : kAllGroups)
-        for (double v : mlp.grad(grp)) ASSERT_EQ(v, 0.0);
+        for (double v : grads[grp]) ASSERT_EQ(v, 0.0);
+    // Gradients shaped for another MLP are refused rather than written out of bounds.
+    const BasicLightingMlp<double> bigger(5, 9);
+    EXPECT_THROW(grads.backward(bigger, bigger.forward(4), g), Error);
 }
 
 TEST(TrainMlp, ForwardRejectsBadImageIndex) {

@@ -19,17 +19,9 @@ static_assert(std::endian::native == std::endian::little, "the MLP file format i
 
 constexpr char kMagic[8] = {'L', 'G', 'L', 'M', 'L', 'P', '0', '1'};
 
-struct LayerShape {
-    int out, in;
-};
-
-// Shapes of the three Linear layers: 24 -> 64 -> 64 -> 27.
-constexpr LayerShape kLayers[3] = {
-    {kMlpWidth, kEmbeddingDim}, {kMlpWidth, kMlpWidth}, {kEnvShOutputs, kMlpWidth}};
-
 // y = W x + b with W row-major (out x in), as nn.Linear.
 template <typename T>
-void linear(const std::vector<T>& w, const std::vector<T>& b, LayerShape s, const T* x, T* y) {
+void linear(const std::vector<T>& w, const std::vector<T>& b, MlpLayerShape s, const T* x, T* y) {
     for (int o = 0; o < s.out; ++o) {
         T acc = b[o];
         const T* row = &w[static_cast<std::size_t>(o) * s.in];
@@ -38,36 +30,9 @@ void linear(const std::vector<T>& w, const std::vector<T>& b, LayerShape s, cons
     }
 }
 
-// Backward of linear: gW += gy x^T, gb += gy, and (if gx) gx = W^T gy.
-template <typename T>
-void linear_backward(const std::vector<T>& w, LayerShape s, const T* x, const T* gy, std::vector<T>& gw,
-                     std::vector<T>& gb, T* gx) {
-    if (gx)
-        for (int i = 0; i < s.in; ++i) gx[i] = 0;
-    for (int o = 0; o < s.out; ++o) {
-        const std::size_t r = static_cast<std::size_t>(o) * s.in;
-        gb[o] += gy[o];
-        for (int i = 0; i < s.in; ++i) gw[r + i] += gy[o] * x[i];
-        if (gx)
-            for (int i = 0; i < s.in; ++i) gx[i] += w[r + i] * gy[o];
-    }
-}
-
 template <typename T, std::size_t N>
 void relu(std::array<T, N>& v) {
     for (T& x : v) x = x > T(0) ? x : T(0);
-}
-
-// Gradient through a ReLU whose output is h: passes where h > 0 (as PyTorch: zero at exactly 0).
-template <typename T, std::size_t N>
-void relu_backward(const std::array<T, N>& h, std::array<T, N>& g) {
-    for (std::size_t i = 0; i < N; ++i)
-        if (!(h[i] > T(0))) g[i] = 0;
-}
-
-// The 27 outputs <-> 9 x RGB coefficients: official `reshape(3, 9)`, so output ch * 9 + k is (k, ch).
-constexpr int out_index(int k, int ch) {
-    return ch * kShCount + k;
 }
 
 void read_exact(std::ifstream& in, const std::string& path, void* dst, std::size_t bytes) {
@@ -87,7 +52,7 @@ std::size_t BasicLightingMlp<T>::group_size(MlpGroup g, int num_images) {
     if (g == MlpGroup::kEmbedding) return static_cast<std::size_t>(num_images) * kEmbeddingDim;
     const int layer = (static_cast<int>(g) - 1) / 2;
     const bool is_weight = (static_cast<int>(g) - 1) % 2 == 0;
-    const LayerShape s = kLayers[layer];
+    const MlpLayerShape s = kMlpLayers[layer];
     return static_cast<std::size_t>(is_weight ? s.out * s.in : s.out);
 }
 
@@ -100,14 +65,13 @@ BasicLightingMlp<T>::BasicLightingMlp(int num_images, std::uint32_t seed) : num_
     for (int gi = 0; gi < kMlpGroupCount; ++gi) {
         const auto g = static_cast<MlpGroup>(gi);
         params_[gi].resize(group_size(g, num_images));
-        grads_[gi].assign(params_[gi].size(), T(0));
         if (g == MlpGroup::kEmbedding) {
             for (T& v : params_[gi]) v = static_cast<T>(normal(rng));
             continue;
         }
         // nn.Linear.reset_parameters: kaiming_uniform(a = sqrt 5) for W and U(+-1/sqrt(fan_in)) for b, which
         // are both U(-1/sqrt(fan_in), 1/sqrt(fan_in)).
-        const double bound = 1.0 / std::sqrt(static_cast<double>(kLayers[(gi - 1) / 2].in));
+        const double bound = 1.0 / std::sqrt(static_cast<double>(kMlpLayers[(gi - 1) / 2].in));
         std::uniform_real_distribution<double> uniform(-bound, bound);
         for (T& v : params_[gi]) v = static_cast<T>(uniform(rng));
     }
@@ -123,42 +87,16 @@ LightingForward<T> BasicLightingMlp<T>::forward(int image) const {
     const T* row = &param(MlpGroup::kEmbedding)[static_cast<std::size_t>(image) * kEmbeddingDim];
     std::copy(row, row + kEmbeddingDim, f.input.begin());
 
-    linear(param(MlpGroup::kW1), param(MlpGroup::kB1), kLayers[0], f.input.data(), f.h1.data());
+    linear(param(MlpGroup::kW1), param(MlpGroup::kB1), kMlpLayers[0], f.input.data(), f.h1.data());
     relu(f.h1);
-    linear(param(MlpGroup::kW2), param(MlpGroup::kB2), kLayers[1], f.h1.data(), f.h2.data());
+    linear(param(MlpGroup::kW2), param(MlpGroup::kB2), kMlpLayers[1], f.h1.data(), f.h2.data());
     relu(f.h2);
     std::array<T, kEnvShOutputs> out{};
-    linear(param(MlpGroup::kW3), param(MlpGroup::kB3), kLayers[2], f.h2.data(), out.data());
+    linear(param(MlpGroup::kW3), param(MlpGroup::kB3), kMlpLayers[2], f.h2.data(), out.data());
 
     for (int k = 0; k < kShCount; ++k)
-        for (int ch = 0; ch < 3; ++ch) f.sh.c[k][ch] = out[out_index(k, ch)];
+        for (int ch = 0; ch < 3; ++ch) f.sh.c[k][ch] = out[env_sh_output(k, ch)];
     return f;
-}
-
-template <typename T>
-void BasicLightingMlp<T>::backward(const LightingForward<T>& fwd, const ShCoeffs<T>& g_sh) {
-    std::array<T, kEnvShOutputs> g_out{};
-    for (int k = 0; k < kShCount; ++k)
-        for (int ch = 0; ch < 3; ++ch) g_out[out_index(k, ch)] = g_sh.c[k][ch];
-
-    std::array<T, kMlpWidth> g_h2{}, g_h1{};
-    linear_backward(param(MlpGroup::kW3), kLayers[2], fwd.h2.data(), g_out.data(), grad(MlpGroup::kW3),
-                    grad(MlpGroup::kB3), g_h2.data());
-    relu_backward(fwd.h2, g_h2);
-    linear_backward(param(MlpGroup::kW2), kLayers[1], fwd.h1.data(), g_h2.data(), grad(MlpGroup::kW2),
-                    grad(MlpGroup::kB2), g_h1.data());
-    relu_backward(fwd.h1, g_h1);
-    std::array<T, kEmbeddingDim> g_e{};
-    linear_backward(param(MlpGroup::kW1), kLayers[0], fwd.input.data(), g_h1.data(), grad(MlpGroup::kW1),
-                    grad(MlpGroup::kB1), g_e.data());
-
-    T* g_row = &grad(MlpGroup::kEmbedding)[static_cast<std::size_t>(fwd.image) * kEmbeddingDim];
-    for (int i = 0; i < kEmbeddingDim; ++i) g_row[i] += g_e[i];
-}
-
-template <typename T>
-void BasicLightingMlp<T>::zero_grad() {
-    for (auto& g : grads_) std::fill(g.begin(), g.end(), T(0));
 }
 
 template class BasicLightingMlp<float>;

@@ -10,9 +10,8 @@
 //                                                           channel, column = SH index k in sh.h order)
 //
 // Parameters are flat row-major arrays, one per group (the embedding table num_images x 24, then W (out x in,
-// PyTorch layout) and b of each layer), with a gradient array of the same shape per group, so an optimizer
-// (train/adam.h) treats them generically. Gradients are dense and accumulate over backward calls until
-// zero_grad(); the embedding gradient is dense too (zeros for rows not used), as PyTorch's nn.Embedding.
+// PyTorch layout) and b of each layer), so that an optimizer (train/adam.h) treats them generically. This is
+// the model alone: its gradients live with whoever optimises it (train/lighting_mlp_gradients.h).
 //
 // Initialisation follows PyTorch's defaults in distribution: embedding ~ N(0, 1); every Linear weight and
 // bias ~ U(-1/sqrt(fan_in), 1/sqrt(fan_in)). The draws come from a seeded std::mt19937 (in double, then cast
@@ -33,6 +32,18 @@ namespace lumigauss {
 inline constexpr int kEmbeddingDim = 24;  // N_a
 inline constexpr int kMlpWidth = 64;      // mlp_W
 inline constexpr int kEnvShOutputs = 3 * kShCount;
+
+// The three Linear layers: 24 -> 64 -> 64 -> 27, W of each out x in.
+struct MlpLayerShape {
+    int out, in;
+};
+inline constexpr std::array<MlpLayerShape, 3> kMlpLayers{
+    {{kMlpWidth, kEmbeddingDim}, {kMlpWidth, kMlpWidth}, {kEnvShOutputs, kMlpWidth}}};
+
+// The 27 outputs <-> 9 x RGB coefficients: official `reshape(3, 9)`, so output ch * 9 + k is (k, ch).
+constexpr int env_sh_output(int k, int ch) {
+    return ch * kShCount + k;
+}
 
 // The parameter groups, in storage and file order.
 enum class MlpGroup : int { kEmbedding = 0, kW1, kB1, kW2, kB2, kW3, kB3 };
@@ -63,16 +74,8 @@ class BasicLightingMlp {
     LightingForward<T> forward(int image) const;
     ShCoeffs<T> env_sh(int image) const { return forward(image).sh; }
 
-    // Adds dL/dparams for dL/dSH = g_sh of the pass `fwd` into the gradient arrays (weights, biases and the
-    // embedding row fwd.image). Uses the parameters as they are now, which must be those of the forward.
-    void backward(const LightingForward<T>& fwd, const ShCoeffs<T>& g_sh);
-
-    void zero_grad();
-
     std::vector<T>& param(MlpGroup g) { return params_[index(g)]; }
     const std::vector<T>& param(MlpGroup g) const { return params_[index(g)]; }
-    std::vector<T>& grad(MlpGroup g) { return grads_[index(g)]; }
-    const std::vector<T>& grad(MlpGroup g) const { return grads_[index(g)]; }
 
     // Row width of a group for row-wise optimizer operations (the embedding: 24 per image; others: 1).
     static int row_width(MlpGroup g) { return g == MlpGroup::kEmbedding ? kEmbeddingDim : 1; }
@@ -84,7 +87,6 @@ class BasicLightingMlp {
 
     int num_images_ = 0;
     std::array<std::vector<T>, kMlpGroupCount> params_;
-    std::array<std::vector<T>, kMlpGroupCount> grads_;
 };
 
 using LightingMlp = BasicLightingMlp<float>;
@@ -93,7 +95,7 @@ using LightingMlp = BasicLightingMlp<float>;
 //   8 bytes  magic "LGLMLP01"
 //   5 x int32  num_images, embedding dim (24), width (64), outputs (27), group count (7)
 //   then, for each group in MlpGroup order, its float32 values (row-major, sizes as group_size()).
-// Only the parameters are stored (no gradients, no optimizer state).
+// Only the parameters are stored (no optimizer state).
 void save_lighting_mlp(const std::string& path, const LightingMlp& mlp);
 // Throws Error naming the file if it is missing, truncated, has another magic or other dimensions.
 LightingMlp load_lighting_mlp(const std::string& path);

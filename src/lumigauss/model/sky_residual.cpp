@@ -23,23 +23,13 @@ void read_exact(std::ifstream& in, const std::string& path, void* data, std::siz
 }  // namespace
 
 SkyResiduals::SkyResiduals(int num_images)
-    : params_(std::size_t(std::max(num_images, 0)) * kRowWidth, 0.0f), grads_(params_.size(), 0.0f) {}
+    : params_(std::size_t(std::max(num_images, 0)) * kRowWidth, 0.0f) {}
 
 Sh4Coeffs<float> SkyResiduals::get(int image) const {
     Sh4Coeffs<float> r;
     const float* row = params_.data() + std::size_t(image) * kRowWidth;
     for (int k = 0; k < kSh4Count; ++k) r.c[k] = {row[3 * k], row[3 * k + 1], row[3 * k + 2]};
     return r;
-}
-
-void SkyResiduals::add_grad(int image, const Sh4Coeffs<float>& g) {
-    float* row = grads_.data() + std::size_t(image) * kRowWidth;
-    for (int k = 0; k < kSh4Count; ++k)
-        for (int c = 0; c < 3; ++c) row[3 * k + c] += g.c[k][c];
-}
-
-void SkyResiduals::zero_grad() {
-    std::fill(grads_.begin(), grads_.end(), 0.0f);
 }
 
 void save_sky_residuals(const std::string& path, const SkyResiduals& residuals) {

@@ -1,7 +1,8 @@
 #pragma once
 // Per training photo, the residual of its sky's radiance (shading/sky_colour.h): 25 RGB coefficients of a
 // degree-4 SH that only the sky drawn behind the surfels sees, stored flat as [image][k * 3 + c] so that an
-// optimizer (train/adam.h, one row per photo) treats it as any parameter group.
+// optimizer (train/adam.h, one row per photo) treats it as any parameter group. The parameters alone: their
+// gradient lives with the trainer (train/sky_losses.h, SkyResidualGradients).
 #include <string>
 #include <vector>
 
@@ -19,17 +20,12 @@ class SkyResiduals {
     int num_images() const { return int(params_.size() / kRowWidth); }
     bool empty() const { return params_.empty(); }
     Sh4Coeffs<float> get(int image) const;
-    // Adds g into the gradient row of `image`.
-    void add_grad(int image, const Sh4Coeffs<float>& g);
-    void zero_grad();
 
     std::vector<float>& params() { return params_; }
     const std::vector<float>& params() const { return params_; }
-    std::vector<float>& grads() { return grads_; }
-    const std::vector<float>& grads() const { return grads_; }
 
   private:
-    std::vector<float> params_, grads_;
+    std::vector<float> params_;
 };
 
 // File (binary, little-endian), written atomically: magic "LGSKYR01", int32 number of photos, int32

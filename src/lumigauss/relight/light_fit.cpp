@@ -10,6 +10,7 @@
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/train/adam.h"
 #include "lumigauss/train/image_losses.h"
+#include "lumigauss/train/lighting_mlp_gradients.h"
 #include "lumigauss/train/physical_losses.h"
 #include "lumigauss/train/view_shading_backward.h"
 #include "lumigauss/util/error.h"
@@ -98,9 +99,9 @@ class LightParameters {
             to_flat(g_sh, grads_);
             return;
         }
-        mlp_.zero_grad();
-        mlp_.backward(forward_, g_sh);
-        const std::vector<float>& g = mlp_.grad(MlpGroup::kEmbedding);
+        mlp_grads_.reset(mlp_);
+        mlp_grads_.backward(mlp_, forward_, g_sh);
+        const std::vector<float>& g = mlp_grads_[MlpGroup::kEmbedding];
         std::copy(g.begin(), g.begin() + kEmbeddingDim, grads_.begin());
     }
 
@@ -117,6 +118,7 @@ class LightParameters {
     AdamGroup adam_;
     double base_lr_ = 0;
     LightingMlp mlp_;
+    LightingMlpGradients mlp_grads_;
     LightingForward<float> forward_;
 };
 

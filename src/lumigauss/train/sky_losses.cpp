@@ -130,4 +130,14 @@ std::vector<float> background_match_mask(std::span<const float> photo, std::span
     return out;
 }
 
+void SkyResidualGradients::reset(const SkyResiduals& residuals) {
+    values_.assign(residuals.params().size(), 0.0f);
+}
+
+void SkyResidualGradients::add(int image, const Sh4Coeffs<float>& g) {
+    float* row = values_.data() + std::size_t(image) * SkyResiduals::kRowWidth;
+    for (int k = 0; k < kSh4Count; ++k)
+        for (int c = 0; c < 3; ++c) row[3 * k + c] += g.c[k][c];
+}
+
 }  // namespace lumigauss

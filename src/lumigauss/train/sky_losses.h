@@ -8,6 +8,7 @@
 
 #include "lumigauss/io/image.h"
 #include "lumigauss/math/vec.h"
+#include "lumigauss/model/sky_residual.h"
 
 namespace lumigauss {
 
@@ -36,5 +37,19 @@ double sky_colour_loss(std::span<const float> sky, std::span<const float> radian
 std::vector<float> background_match_mask(std::span<const float> photo, std::span<const float> sky,
                                          std::span<const float> photometric_mask, std::span<const Vec3f> rays,
                                          Vec3f up, int width, int height, double tolerance);
+
+// The gradient of the sky losses with respect to the per-photo sky residuals (model/sky_residual.h), stored
+// as the residuals are: one row of SkyResiduals::kRowWidth per photo.
+class SkyResidualGradients {
+  public:
+    // All zero, shaped as `residuals`.
+    void reset(const SkyResiduals& residuals);
+    // Adds g into the row of `image`.
+    void add(int image, const Sh4Coeffs<float>& g);
+    const std::vector<float>& values() const { return values_; }
+
+  private:
+    std::vector<float> values_;
+};
 
 }  // namespace lumigauss

@@ -318,8 +318,8 @@ StepReport Trainer::step() {
     report.iteration = it;
     report.stage = stage;
     state_.model.zero_grad();
-    state_.lighting.zero_grad();
-    state_.sky_residuals.zero_grad();
+    lighting_grads_.reset(state_.lighting);
+    sky_residual_grads_.reset(state_.sky_residuals);
     lighting_has_grad_ = false;
     set_learning_rates(it);
 
@@ -461,7 +461,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
             }
             report.sky_residual = penalty;
             report.total += c.lambda_sky_residual * penalty;
-            state_.sky_residuals.add_grad(report.view, g_res);
+            sky_residual_grads_.add(report.view, g_res);
         }
     }
     report.env = env_nonnegativity_loss(env_pass.sh, c.env_samples, c.seed, it, c.lambda_env, g_env);
@@ -487,7 +487,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     model.accumulate_grads_from_activated(sg);
     const ShCoeffs<float> g_shading = shade_surfels_backward(model, env, mode, s.normals, sg.colors);
     for (int k = 0; k < kShCount; ++k) g_env.c[k] = g_env.c[k] + g_shading.c[k];
-    state_.lighting.backward(env_pass, g_env);
+    lighting_grads_.backward(state_.lighting, env_pass, g_env);
     lighting_has_grad_ = true;
     // Densification statistics come from this render's screen-space gradient (2DGS: radii > 0 visible).
     if (it < c.densify_until) {
@@ -538,7 +538,7 @@ void Trainer::check_finite(std::int64_t it, const StepReport& r) const {
         if (state_.model.has_grad(ModelParam(p)) && !all_finite(state_.model.grad(ModelParam(p))))
             throw NonFiniteError(it, std::string("gradient of ") + GaussianModel::name(ModelParam(p)));
     for (int g = 0; g < kMlpGroupCount; ++g)
-        if (!all_finite(state_.lighting.grad(MlpGroup(g))))
+        if (!all_finite(lighting_grads_[MlpGroup(g)]))
             throw NonFiniteError(it, std::string("gradient of lighting ") + mlp_group_name(MlpGroup(g)));
 }
 
@@ -608,12 +608,12 @@ void Trainer::optimizer_step(std::int64_t it, Stage) {
     if (lighting_has_grad_) {
         for (int g = 0; g < kMlpGroupCount; ++g)
             state_.lighting_adam[std::size_t(g)].step(state_.lighting.param(MlpGroup(g)),
-                                                      state_.lighting.grad(MlpGroup(g)));
+                                                      lighting_grads_[MlpGroup(g)]);
         if (!state_.sky_residuals.empty()) {
             const std::size_t row = std::size_t(last_view_) * SkyResiduals::kRowWidth;
             state_.sky_residual_adam[std::size_t(last_view_)].step(
                 std::span<float>(state_.sky_residuals.params()).subspan(row, SkyResiduals::kRowWidth),
-                std::span<const float>(state_.sky_residuals.grads()).subspan(row, SkyResiduals::kRowWidth));
+                std::span<const float>(sky_residual_grads_.values()).subspan(row, SkyResiduals::kRowWidth));
         }
     }
     times_.optimizer += seconds_since(t0);

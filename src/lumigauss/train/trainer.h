@@ -23,6 +23,8 @@
 #include "lumigauss/train/adam.h"
 #include "lumigauss/train/gaussian_model.h"
 #include "lumigauss/train/ground_seeds.h"
+#include "lumigauss/train/lighting_mlp_gradients.h"
+#include "lumigauss/train/sky_losses.h"
 #include "lumigauss/train/train_config.h"
 
 namespace lumigauss {
@@ -143,6 +145,8 @@ class Trainer {
     TrainState state_;
     std::unique_ptr<Scratch> scratch_;
     PhaseTimes times_;
+    LightingMlpGradients lighting_grads_;      // of this iteration's loss
+    SkyResidualGradients sky_residual_grads_;  // ... (empty without sky residuals)
     bool lighting_has_grad_ = false;
     int last_view_ = 0;  // the photo of the current iteration (its sky residual is stepped)
 };
