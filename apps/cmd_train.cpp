@@ -18,8 +18,11 @@
 #include <optional>
 
 #include "commands.h"
+#include "lumigauss/eval/holdout.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/text_file.h"
+#include "lumigauss/model/scene_record.h"
+#include "lumigauss/model/trained_run.h"
 #include "lumigauss/render/rasterizer.h"
 #include "lumigauss/train/trainer.h"
 #include "lumigauss/train/training_run.h"
@@ -108,6 +111,26 @@ class Progress {
     std::deque<double> psnr_;
 };
 
+// The held-out photos of a snapshot scored as `eval --protocol holdout` would at the training resolution
+// (each photo's light fitted through the network on its left half, the right half scored), with a shorter fit
+// so that a checkpoint does not wait long for it.
+SnapshotScorer held_out_scorer(const std::string& scene, RasterBackend backend) {
+    return [scene, backend](const RunPaths& paths) -> std::optional<HeldOutScore> {
+        const TrainedRun run = load_trained_run(paths.dir);
+        DatasetOptions dopt;
+        dopt.downscale = run.downscale > 0 ? run.downscale : 1;
+        const Dataset data = load_scene_of_run(paths.dir, scene, dopt);
+        if (data.split(Split::Test).empty()) return std::nullopt;
+        HoldoutOptions options;
+        options.fit.variable = LightVariable::Embedding;
+        options.fit.iterations = 100;
+        options.keep_panels = false;
+        options.backend = backend;
+        const HoldoutResult result = evaluate_holdout(run, data, options);
+        return HeldOutScore{result.images.size(), result.mean_shadowed.psnr, result.mean_unshadowed.psnr};
+    };
+}
+
 int run_train(const TrainFlags& f) {
     TrainingRunRequest request;
     request.backend = choose_backend(f.backend);  // before anything is read or written
@@ -127,6 +150,7 @@ int run_train(const TrainFlags& f) {
         if (f.no_test) request.test_every = 0;
         if (f.test_every) request.test_every = *f.test_every;
     }
+    request.score_snapshot = held_out_scorer(f.scene, request.backend);
     TrainingRun run(request);
     const Trainer& trainer = run.trainer();
     const TrainConfig& config = trainer.state().config;
@@ -207,6 +231,14 @@ int run_train(const TrainFlags& f) {
         "physical %.1fs, optimizer %.1fs, densify %.1fs\n",
         t.shading, t.raster_forward, t.losses, t.raster_backward, t.shading_backward, t.physical, t.optimizer,
         t.densify);
+    if (const HeldOutLog& h = run.last_held_out(); h.score)
+        std::printf(
+            "train: %zu held-out photos: PSNR %.2f dB shadowed, %.2f unshadowed (each light fitted on the "
+            "left "
+            "half, the right half scored; %.1f s)\n",
+            h.score->photos, h.score->psnr_shadowed, h.score->psnr_unshadowed, h.seconds);
+    else if (!h.error.empty())
+        std::printf("train: the held-out photos could not be scored: %s\n", h.error.c_str());
     std::printf("train: model %s, lighting %s, photos %s\n", paths.model.c_str(), paths.lighting.c_str(),
                 paths.appearance.c_str());
     return 0;

@@ -29,6 +29,7 @@ namespace {
 using synth_test::TempDir;
 using testing::CommandResult;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using testing::run_lumigauss;
 using testing::shell_quoted;
 namespace fs = std::filesystem;
@@ -198,11 +199,46 @@ TEST(CliTrain, StopAfterThenResumeIsByteIdentical) {
     EXPECT_EQ(std::set<std::int64_t>(its.begin(), its.end()).size(), its.size()) << "duplicated iterations";
     EXPECT_EQ(its, log_iterations(log_a));
     ASSERT_EQ(log_a.size(), log_b.size());
+    // The held-out photos are scored with every checkpoint (20, 40) and at the end (60), the same before and
+    // after the resume.
+    std::vector<std::int64_t> scored;
+    for (const auto& j : log_b)
+        if (j.contains("held_out_psnr")) scored.push_back(j["iteration"]);
+    EXPECT_EQ(scored, (std::vector<std::int64_t>{20, 40, 60}));
     for (std::size_t i = 0; i < log_a.size(); ++i) {
-        log_a[i].erase("elapsed_s");
-        log_b[i].erase("elapsed_s");
+        for (auto* line : {&log_a[i], &log_b[i]}) line->erase("elapsed_s"), line->erase("held_out_s");
         EXPECT_EQ(log_a[i], log_b[i]);
     }
+}
+
+// The held-out photos are scored as `eval --protocol holdout --fit-iterations 100` scores them: the last log
+// line holds what eval reports for the finished model, and the end of the output says it. Without held-out
+// photos (--no-test) nothing is scored.
+TEST(CliTrain, HeldOutScoresAreTheHoldoutProtocols) {
+    TempDir tmp("cli_train_held_out");
+    const std::string run = tmp / "run";
+    const CommandResult r = run_lumigauss(train_args(run, " --preset fast --iterations 20"), tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("2 held-out photos: PSNR"));
+    const std::vector<nlohmann::json> log = read_log(run + "/log.jsonl");
+    ASSERT_FALSE(log.empty());
+    ASSERT_TRUE(log.back().contains("held_out_psnr")) << log.back().dump();
+    const CommandResult e =
+        run_lumigauss("eval " + shell_quoted(run) + " --protocol holdout --fit-iterations 100 -o " +
+                          shell_quoted(tmp / "eval") + " -q",
+                      tmp);
+    ASSERT_EQ(e.exit_code, 0) << e.output;
+    const std::size_t at = e.output.find("eval-summary: shadowed_psnr=");
+    ASSERT_NE(at, std::string::npos) << e.output;
+    const double eval_psnr =
+        std::stod(e.output.substr(at + std::string("eval-summary: shadowed_psnr=").size()));
+    EXPECT_NEAR(log.back()["held_out_psnr"].get<double>(), eval_psnr, 1e-4);
+
+    const std::string all = tmp / "all";
+    const CommandResult n = run_lumigauss(train_args(all, " --preset fast --iterations 20 --no-test"), tmp);
+    ASSERT_EQ(n.exit_code, 0) << n.output;
+    EXPECT_THAT(n.output, Not(HasSubstr("held-out photos")));
+    for (const nlohmann::json& j : read_log(all + "/log.jsonl")) EXPECT_FALSE(j.contains("held_out_psnr"));
 }
 
 // ---- 9. An existing run is protected ---------------------------------------------------------------------

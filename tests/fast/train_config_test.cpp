@@ -124,6 +124,7 @@ std::vector<MemberChange> every_member() {
         {"lambda_sky_residual", [](TrainConfig& c) { c.lambda_sky_residual = 0.125; }},
         {"lr_sky_residual", [](TrainConfig& c) { c.lr_sky_residual = 0.03; }},
         {"sky_pins_light", [](TrainConfig& c) { c.sky_pins_light = false; }},
+        {"score_held_out", [](TrainConfig& c) { c.score_held_out = false; }},
         {"lighting_init_radiance", [](TrainConfig& c) { c.lighting_init_radiance = 0.7; }},
         {"use_sky_masks", [](TrainConfig& c) { c.use_sky_masks = false; }},
         {"lambda_sky_alpha", [](TrainConfig& c) { c.lambda_sky_alpha = 0.3; }},
@@ -278,7 +279,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 64, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 65, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;

@@ -41,20 +41,22 @@ TEST(ProgressReport, ChartsFromTheLogAndImagesNewestFirst) {
         R"({"iteration": 20, "psnr": null, "total": 0.4, "surfels": 120, "elapsed_s": 60})"
         "\n"
         "not json at all\n"
-        R"({"iteration": 30, "psnr": 14.0, "total": 0.3, "surfels": 150, "elapsed_s": 120})"
+        R"({"iteration": 30, "psnr": 14.0, "total": 0.3, "surfels": 150, "elapsed_s": 120,)"
+        R"( "held_out_psnr": 12.5})"
         "\n";
     const std::string html =
         progress_report_html("run <1>", log, {"progress/0000010.png", "progress/0000030.png"});
-    EXPECT_EQ(count(html, "<svg"), 3u);
+    EXPECT_EQ(count(html, "<svg"), 4u);
     EXPECT_EQ(count(chart_points(html, "psnr"), ","), 2u) << "the null PSNR is a gap, not a zero";
     EXPECT_EQ(count(chart_points(html, "total"), ","), 3u);
     EXPECT_EQ(count(chart_points(html, "surfels"), ","), 3u);
+    EXPECT_EQ(count(chart_points(html, "held_out_psnr"), ","), 1u) << "scored at one snapshot";
     EXPECT_NE(html.find("run &lt;1&gt;"), std::string::npos);
     EXPECT_NE(html.find("iteration 30, 2.0 min"), std::string::npos);
     EXPECT_LT(html.find("0000030.png"), html.find("0000010.png")) << "newest first";
 
     const std::string empty = progress_report_html("r", "", {});
-    EXPECT_EQ(count(empty, "no values yet"), 3u);
+    EXPECT_EQ(count(empty, "no values yet"), 4u);
     EXPECT_NE(empty.find("none yet"), std::string::npos);
 }
 

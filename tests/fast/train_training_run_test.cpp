@@ -4,12 +4,15 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "fast/io_test_util.h"
 #include "lumigauss/io/dataset.h"
-#include "lumigauss/io/text_file.h"
 #include "lumigauss/io/ply.h"
+#include "lumigauss/io/text_file.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/synth/synth.h"
 #include "lumigauss/train/checkpoint.h"
@@ -183,6 +186,82 @@ TEST(TrainingRun, AStoppedRunCanBeOpened) {
     for (const ModelParam p : kAllModelParams)
         EXPECT_EQ(opened.model.param(p), checkpoint.model.param(p)) << "parameter " << int(p);
     EXPECT_EQ(opened.image_names, checkpoint.image_names);
+}
+
+std::vector<nlohmann::json> log_lines(const std::string& path) {
+    std::vector<nlohmann::json> lines;
+    std::ifstream in(path);
+    for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
+    return lines;
+}
+
+// The scorer sees each snapshot once it is written (every checkpoint and the end), its scores go into that
+// iteration's log line, and score_held_out = false turns it off.
+TEST(TrainingRun, HeldOutScoresGoIntoTheLogWithEverySnapshot) {
+    TempDir tmp("training_run_held_out");
+    TrainingRunRequest r = request(tmp / "run", 25);
+    r.config.checkpoint_interval = 10;
+    r.config.log_interval = 4;  // 10 and 25 are not logged iterations: scoring logs them anyway
+    std::vector<std::int64_t> seen;
+    r.score_snapshot = [&](const RunPaths& paths) -> std::optional<HeldOutScore> {
+        const TrainState snapshot = load_checkpoint(paths.checkpoint);
+        EXPECT_EQ(load_trained_run(paths.dir).model.size(), snapshot.model.size());
+        seen.push_back(snapshot.iteration);
+        return HeldOutScore{3, 10.0 + double(snapshot.iteration), 20.0};
+    };
+    TrainingRun run(r);
+    ASSERT_EQ(run.run(
+                  0, [] { return false; }, [](const StepReport&) {}),
+              TrainingOutcome::Finished);
+    EXPECT_EQ(seen, (std::vector<std::int64_t>{10, 20, 25}));
+    std::vector<std::int64_t> scored;
+    for (const nlohmann::json& j : log_lines(run.paths().log))
+        if (j.contains("held_out_psnr")) {
+            scored.push_back(j["iteration"]);
+            EXPECT_EQ(j["held_out_psnr"], 10.0 + j["iteration"].get<double>());
+            EXPECT_EQ(j["held_out_psnr_unshadowed"], 20.0);
+            EXPECT_EQ(j["held_out_photos"], 3);
+            EXPECT_TRUE(j["held_out_s"].is_number());
+        }
+    EXPECT_EQ(scored, seen);
+    ASSERT_TRUE(run.last_held_out().score.has_value());
+    EXPECT_EQ(run.last_held_out().score->psnr_shadowed, 35.0);
+
+    seen.clear();
+    r.out = tmp / "off";
+    r.config.score_held_out = false;
+    TrainingRun off(r);
+    ASSERT_EQ(off.run(
+                  0, [] { return false; }, [](const StepReport&) {}),
+              TrainingOutcome::Finished);
+    EXPECT_TRUE(seen.empty());
+    for (const nlohmann::json& j : log_lines(off.paths().log)) EXPECT_FALSE(j.contains("held_out_psnr"));
+}
+
+// A scorer that fails is reported once in the log and never stops the training.
+TEST(TrainingRun, AFailingScorerIsReportedOnceAndTrainingGoesOn) {
+    TempDir tmp("training_run_scorer_fails");
+    TrainingRunRequest r = request(tmp / "run", 25);
+    r.config.checkpoint_interval = 10;
+    int calls = 0;
+    r.score_snapshot = [&](const RunPaths&) -> std::optional<HeldOutScore> {
+        ++calls;
+        throw Error("test photo x.png: no pixel to score");
+    };
+    TrainingRun run(r);
+    ASSERT_EQ(run.run(
+                  0, [] { return false; }, [](const StepReport&) {}),
+              TrainingOutcome::Finished);
+    EXPECT_EQ(calls, 1);
+    int errors = 0;
+    for (const nlohmann::json& j : log_lines(run.paths().log))
+        if (j.contains("held_out_error")) {
+            ++errors;
+            EXPECT_EQ(j["iteration"], 10);
+            EXPECT_NE(j["held_out_error"].get<std::string>().find("x.png"), std::string::npos);
+        }
+    EXPECT_EQ(errors, 1);
+    EXPECT_TRUE(fs::exists(run.paths().model));
 }
 
 // A damaged log line must not block --resume (it stopped it with "internal error: stoll" before): the

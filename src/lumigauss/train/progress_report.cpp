@@ -89,9 +89,15 @@ std::string svg_chart(const Series& s) {
 
 std::string progress_report_html(const std::string& run_name, const std::string& log_text,
                                  const std::vector<std::string>& progress_images) {
-    std::vector<Series> series = {{"psnr", "training PSNR (dB, the logged photo)", {}, {}},
-                                  {"total", "total loss", {}, {}},
-                                  {"surfels", "surfels", {}, {}}};
+    std::vector<Series> series = {
+        {"psnr", "training PSNR (dB, the logged photo)", {}, {}},
+        {"held_out_psnr",
+         "held-out PSNR (dB, mean over the test photos: light fitted on the left half, "
+         "right half scored)",
+         {},
+         {}},
+        {"total", "total loss", {}, {}},
+        {"surfels", "surfels", {}, {}}};
     std::istringstream lines(log_text);
     std::string line;
     double last_iteration = 0, elapsed = 0;

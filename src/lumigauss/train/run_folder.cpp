@@ -9,7 +9,7 @@ void save_run_model(const RunPaths& paths, const TrainState& state) {
     save_run_model(paths, state.model, state.lighting, state.image_names, state.sky_residuals);
 }
 
-std::string step_log_line(const StepReport& r, double elapsed_seconds) {
+std::string step_log_line(const StepReport& r, double elapsed_seconds, const HeldOutLog& held_out) {
     nlohmann::json j;
     j["iteration"] = r.iteration;
     j["stage"] = int(r.stage);
@@ -45,6 +45,13 @@ std::string step_log_line(const StepReport& r, double elapsed_seconds) {
         j["pruned"] = r.densified.pruned;
     }
     if (r.opacity_reset) j["opacity_reset"] = true;
+    if (held_out.score) {
+        j["held_out_psnr"] = held_out.score->psnr_shadowed;
+        j["held_out_psnr_unshadowed"] = held_out.score->psnr_unshadowed;
+        j["held_out_photos"] = held_out.score->photos;
+        j["held_out_s"] = held_out.seconds;
+    }
+    if (!held_out.error.empty()) j["held_out_error"] = held_out.error;
     j["elapsed_s"] = elapsed_seconds;
     return j.dump();
 }

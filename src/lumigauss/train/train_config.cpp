@@ -107,6 +107,7 @@ constexpr std::array kFields = {
     LUMIGAUSS_FIELD(lambda_opacity),
     LUMIGAUSS_FIELD(checkpoint_interval),
     LUMIGAUSS_FIELD(log_interval),
+    LUMIGAUSS_FIELD(score_held_out),
 };
 
 #undef LUMIGAUSS_FIELD

@@ -73,7 +73,8 @@ int auto_downscale(const Dataset& data, std::string& note) {
 
 }  // namespace
 
-TrainingRun::TrainingRun(const TrainingRunRequest& request) : paths_(run_paths(request.out)) {
+TrainingRun::TrainingRun(const TrainingRunRequest& request)
+    : paths_(run_paths(request.out)), scorer_(request.score_snapshot) {
     if (request.resume) {
         if (!std::filesystem::exists(paths_.checkpoint))
             fail_in_file(paths_.checkpoint, "no checkpoint to resume from (start the run without --resume)");
@@ -130,11 +131,25 @@ TrainingRun::~TrainingRun() = default;
 void TrainingRun::save_checkpoint_and_snapshot() {
     save_checkpoint(paths_.checkpoint, trainer_->state());
     save_run_model(paths_, trainer_->state());
-    write_progress(paths_, *trainer_, kPreviewViews);
 }
 
 double TrainingRun::elapsed_seconds() const {
     return elapsed_;
+}
+
+HeldOutLog TrainingRun::score_snapshot() {
+    HeldOutLog held_out;
+    if (!scorer_ || !trainer_->state().config.score_held_out) return held_out;
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+        held_out.score = scorer_(paths_);
+    } catch (const std::exception& e) {
+        held_out.error = e.what();
+        scorer_ = nullptr;  // reported once; the training goes on
+    }
+    held_out.seconds = seconds_since(t0);
+    last_held_out_ = held_out;
+    return held_out;
 }
 
 TrainingOutcome TrainingRun::run(std::int64_t stop_after, const std::function<bool()>& stop_requested,
@@ -147,6 +162,7 @@ TrainingOutcome TrainingRun::run(std::int64_t stop_after, const std::function<bo
     while (!trainer_->done()) {
         if (stop_requested() || (stop_after > 0 && trainer_->iteration() >= stop_after)) {
             save_checkpoint_and_snapshot();
+            write_progress(paths_, *trainer_, kPreviewViews);
             elapsed_ = elapsed();
             return TrainingOutcome::Stopped;
         }
@@ -159,16 +175,21 @@ TrainingOutcome TrainingRun::run(std::int64_t stop_after, const std::function<bo
             elapsed_ = elapsed();
             return TrainingOutcome::NonFinite;
         }
-        const bool log_now =
-            r.iteration % config.log_interval == 0 || r.densify_ran || r.prune_ran || trainer_->done();
-        if (log_now) log << step_log_line(r, elapsed()) << '\n' << std::flush;
-        on_step(r);
-        if (config.checkpoint_interval > 0 && r.iteration % config.checkpoint_interval == 0 &&
-            !trainer_->done())
+        // A snapshot (every checkpoint and the end) is scored before its iteration's log line, which carries
+        // the scores, and the progress report, whose charts read the log.
+        const bool checkpoint_now = config.checkpoint_interval > 0 &&
+                                    r.iteration % config.checkpoint_interval == 0 && !trainer_->done();
+        HeldOutLog held_out;
+        if (checkpoint_now || trainer_->done()) {
             save_checkpoint_and_snapshot();
+            held_out = score_snapshot();
+        }
+        const bool log_now = r.iteration % config.log_interval == 0 || r.densify_ran || r.prune_ran ||
+                             trainer_->done() || held_out.score || !held_out.error.empty();
+        if (log_now) log << step_log_line(r, elapsed(), held_out) << '\n' << std::flush;
+        if (checkpoint_now) write_progress(paths_, *trainer_, kPreviewViews);
+        on_step(r);
     }
-    save_checkpoint(paths_.checkpoint, trainer_->state());
-    save_run_model(paths_, trainer_->state());
     write_previews((std::filesystem::path(paths_.dir) / "previews").string(), *trainer_, kPreviewViews);
     write_progress(paths_, *trainer_, kPreviewViews);
     elapsed_ = elapsed();

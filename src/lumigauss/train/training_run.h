@@ -13,10 +13,15 @@
 
 #include "lumigauss/model/run_files.h"
 #include "lumigauss/render/rasterizer.h"
+#include "lumigauss/train/run_folder.h"
 #include "lumigauss/train/train_config.h"
 #include "lumigauss/train/trainer.h"
 
 namespace lumigauss {
+
+// Scores the model files a snapshot has just written (paths), or returns nothing (no photo to score). The
+// protocol is the caller's: `train` passes eval's holdout protocol, which train/ cannot include.
+using SnapshotScorer = std::function<std::optional<HeldOutScore>(const RunPaths& paths)>;
 
 struct TrainingRunRequest {
     std::string scene, out;
@@ -28,6 +33,11 @@ struct TrainingRunRequest {
     // A new run's split override (DatasetOptions::test_every): set, every n-th photo is a test photo (0:
     // none). A resumed run keeps the split it recorded (scene.json).
     std::optional<int> test_every;
+    // Called with every periodic checkpoint and at the end when the config's score_held_out is on; its scores
+    // go into log.jsonl with that iteration's line ("held_out_psnr", "held_out_psnr_unshadowed",
+    // "held_out_photos", "held_out_s"). One that throws is reported in the log ("held_out_error") and not
+    // called again: scoring never stops a training run.
+    SnapshotScorer score_snapshot;
 };
 
 enum class TrainingOutcome {
@@ -66,9 +76,13 @@ class TrainingRun {
     // The message of the non-finite value that ended run() (TrainingOutcome::NonFinite).
     const std::string& failure() const { return failure_; }
     double elapsed_seconds() const;  // in run(), this process
+    // The held-out scores of the latest snapshot scored in run() (no score before one, or without a scorer).
+    const HeldOutLog& last_held_out() const { return last_held_out_; }
 
   private:
     void save_checkpoint_and_snapshot();
+    // The held-out scores of the snapshot just written (nothing without a scorer or when scoring is off).
+    HeldOutLog score_snapshot();
 
     RunPaths paths_;
     std::unique_ptr<Trainer> trainer_;
@@ -79,6 +93,8 @@ class TrainingRun {
     double far_point_limit_ = 0;
     std::string failure_;
     double elapsed_ = 0;
+    SnapshotScorer scorer_;
+    HeldOutLog last_held_out_;
 };
 
 // Keeps the log lines up to `iteration` (a resumed run rewrites what followed its checkpoint); lines that are
