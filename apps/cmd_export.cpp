@@ -20,12 +20,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "commands.h"
 #include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/export/baked_colours.h"
 #include "lumigauss/export/compressed_ply.h"
 #include "lumigauss/export/environment_files.h"
+#include "lumigauss/export/export_region.h"
 #include "lumigauss/export/gltf_splats.h"
 #include "lumigauss/export/ply_3dgs.h"
 #include "lumigauss/export/relightable_bundle.h"
@@ -54,6 +56,9 @@ struct ExportOptions {
     std::vector<std::string> bake_options_given;  // options that only shape a baked light
     std::string orient = "none";
     bool orient_given = false;
+    std::optional<double> crop_radius;
+    std::string crop_box;
+    bool recentre = false;
     int threads = 0;
     bool quiet = false;
 };
@@ -71,6 +76,23 @@ void make_parent(const std::string& path) {
 const char* seen_side_note(const TrainedRun& run) {
     return run.photo_centres.empty() ? "the +normal side (no training cameras recorded)"
                                      : "the side the training photos see";
+}
+
+// --crop-radius, --crop-box, --recentre: the run's surfels and training cameras replaced by the region's.
+void crop_and_recentre(TrainedRun& run, const ExportRegion& region, bool quiet) {
+    const std::size_t before = run.model.size();
+    RegionedModel kept = apply_export_region(run.model, run.photo_centres, region);
+    run.model = std::move(kept.model);
+    run.photo_centres = std::move(kept.cameras);
+    if (quiet) return;
+    if (region.radius || region.box)
+        std::printf("export: the crop keeps %zu of %zu surfels\n", run.model.size(), before);
+    if (region.recentre)
+        std::printf(
+            "export: origin moved to the region's centre %.6g,%.6g,%.6g (positions translated by "
+            "%.6g,%.6g,%.6g)\n",
+            kept.centre.x, kept.centre.y, kept.centre.z, kept.translation.x, kept.translation.y,
+            kept.translation.z);
 }
 
 void run_export(const ExportOptions& o) {
@@ -112,7 +134,18 @@ void run_export(const ExportOptions& o) {
     if (o.sh_degree < 0 || o.sh_degree > 3)
         throw Error("--sh-degree " + std::to_string(o.sh_degree) + ": use 0, 1, 2 or 3");
 
-    const TrainedRun run = load_run_or_ply(source);
+    ExportRegion region;
+    region.radius = o.crop_radius;
+    if (!o.crop_box.empty()) region.box = parse_crop_box(o.crop_box, "--crop-box");
+    region.recentre = o.recentre;
+    if (region.any() && !baked && o.format != "ply-relightable")
+        throw Error(
+            "--crop-radius, --crop-box and --recentre are for the model formats (ply-3dgs, "
+            "compressed-ply, glb, spz, splat, ply-relightable), not " +
+            o.format);
+
+    TrainedRun run = load_run_or_ply(source);
+    if (region.any()) crop_and_recentre(run, region, o.quiet);
     // auto: the up of the training photos the run recorded; +z for a bare PLY.
     const Vec3d up = o.up == "auto" ? run.photos_up.value_or(Vec3d{0, 0, 1}) : parse_up_axis(o.up);
     if (baked) {
@@ -198,9 +231,8 @@ void register_export(CLI::App& app) {
         "export",
         "Export a trained run (or a relightable .ply of the official LumiGauss code) as a baked 3DGS PLY, a "
         "compressed PLY (SuperSplat), a glTF (KHR_gaussian_splatting), an SPZ, a .splat, a relightable PLY "
-        "with its environments, the "
-        "environments alone, or one self-contained web "
-        "page that relights the model in any browser (docs/formats.md)");
+        "with its environments, the environments alone, or one self-contained web page that relights the "
+        "model in any browser (docs/formats.md)");
     cmd->add_option("source", o->source,
                     "training run folder (model.ply, lighting.lgmlp, appearance.json) or a relightable .ply");
     cmd->add_option("--ply", o->ply,
@@ -212,13 +244,12 @@ void register_export(CLI::App& app) {
     cmd->add_option(
            "-o,--output", o->out,
            "output file (ply-3dgs, compressed-ply, glb, spz, splat, html; ply-relightable: FILE.ply + "
-           "FILE.environments.json) "
-           "or folder (env)")
+           "FILE.environments.json) or folder (env)")
         ->required();
     cmd->add_option("--light", o->light,
                     "ply-3dgs/compressed-ply/glb/spz/splat: the lighting to bake, as for `render --light` "
-                    "(training photo, SH .txt, "
-                    "panorama; prefixes photo:, sh:, pano:); html: one more lighting, offered first");
+                    "(training photo, SH .txt, panorama; prefixes photo:, sh:, pano:); html: one more "
+                    "lighting, offered first");
     cmd->add_option("--shading", o->shading,
                     "baked colour: shadowed (the full model: transfer sets) or unshadowed (the normals)")
         ->capture_default_str();
@@ -229,9 +260,7 @@ void register_export(CLI::App& app) {
                o->sh_degree_given = true;
            },
            "ply-3dgs, compressed-ply, glb, spz: degree of the view-dependent colour (0: one colour, the side "
-           "the "
-           "training photos "
-           "see; 1-3: each side of a surfel shows its own colour; default 3)")
+           "the training photos see; 1-3: each side of a surfel shows its own colour; default 3)")
         ->type_name("INT");
     cmd->add_option_function<std::string>(
            "--orient",
@@ -240,10 +269,18 @@ void register_export(CLI::App& app) {
                o->orient_given = true;
            },
            "ply-3dgs, compressed-ply, splat: none (default: the world as trained), y-up (--up turned to +y, "
-           "for y-up viewers "
-           "and engines) or y-down (--up turned to -y: the COLMAP / Inria 3DGS convention most splat viewers "
-           "assume)")
+           "for y-up viewers and engines) or y-down (--up turned to -y: the COLMAP / Inria 3DGS convention "
+           "most splat viewers assume)")
         ->type_name("TEXT");
+    cmd->add_option("--crop-radius", o->crop_radius,
+                    "model formats: keep the surfels within R (world units) of the region's centre (the "
+                    "median surfel centre, or the --crop-box centre)");
+    cmd->add_option(
+        "--crop-box", o->crop_box,
+        "model formats: keep the surfels inside the box X0,Y0,Z0,X1,Y1,Z1 (world axes, as trained)");
+    cmd->add_flag(
+        "--recentre,--recenter", o->recentre,
+        "model formats: move the origin to the region's centre (engines place a model at its origin)");
     cmd->add_option("--up", o->up,
                     "world up (panorama lights, --rotate, the bundle's up): +z, -y, +y, +x, -x, -z, a vector "
                     "X,Y,Z, or auto (the run's training photos; +z for a bare PLY)")

@@ -175,10 +175,7 @@ void run_fit_light(FitLightOptions o) {
         const RasterImages<float> img =
             render_with_environment(run.model, in.camera, r.sh.cast<float>(),
                                     o.fit.shadowed ? ShadingMode::Shadowed : ShadingMode::Unshadowed);
-        Image shown(in.photo.width, in.photo.height, 3);
-        for (std::size_t i = 0; i < shown.pixels.size(); ++i)
-            shown.pixels[i] = std::clamp(img.color[i], 0.0f, 1.0f);
-        write_png(o.render, shown);
+        write_png(o.render, fitted_colour(run, in.camera, img, 0, r.sh));
     }
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("fit-light: masked PSNR %.2f -> %.2f dB, l+ %.3g; wrote %s%s%s (%.1f s)\n", r.initial_psnr,

@@ -14,10 +14,10 @@
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/io/image_metrics.h"
+#include "lumigauss/model/render_model.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_fit.h"
 #include "lumigauss/shading/sh_text.h"
-#include "support/clamped_render.h"
 #include "support/run_cli.h"
 #include "synth_test_util.h"
 
@@ -58,10 +58,12 @@ struct FitSetup {
         std::swap(light.c[1], light.c[3]);
         write_png(photo, rendered(r, view.camera, light));
     }
+    // As the run draws a photo: trained with its sky behind the surfels, the light's sky fills the rest.
     static Image rendered(const TrainedRun& r, const Camera& cam, const ShCoeffs<double>& sh) {
-        return testing::clamped_render(r.model, cam, sh);
+        return fitted_colour(
+            r, cam, render_with_environment(r.model, cam, sh.cast<float>(), ShadingMode::Shadowed), 0, sh);
     }
-    // PSNR over the pixels the model covers, of the run rendered under `sh` against the photo.
+    // PSNR over the whole image, of the run rendered under `sh` against the photo.
     double psnr_with(const ShCoeffs<double>& sh) const {
         const TrainedRun r = load_trained_run(run);
         const Image a = rendered(r, view.camera, sh), b = read_image(photo);

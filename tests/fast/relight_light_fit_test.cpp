@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "lumigauss/model/render_model.h"
 #include "lumigauss/model/view_shading.h"
 #include "lumigauss/relight/light_fit.h"
 #include "lumigauss/util/error.h"
@@ -126,6 +127,31 @@ TEST(LightFit, PixelsOutsideTheMaskDoNotCount) {
     const LightFitResult r = fit_light(run, cam, photo, mask, o);
     EXPECT_GT(r.final_psnr, 40.0);
     EXPECT_LT(relative_error(r.sh, truth), 0.05);
+}
+
+// A run trained with its sky behind the surfels draws the sky of the photo's light where the surfels leave
+// the image uncovered. The fit must draw it so too: over black, those pixels (here most of the image) could
+// not be explained by any light, and the fit of a sky-background run went to 3-12 dB on plaza_mini.
+TEST(LightFit, ASkyBackgroundRunFitsTheSkyBehindTheSurfels) {
+    const Camera cam = testing::test_camera(64, 56);
+    TrainedRun run = in_memory_run(random_model(cam, 8, 12), {});
+    run.sky_background = true;
+    run.sky_horizon = {Vec3f{0, -1, 0}, 5.0f, 20.0f};
+    const ShCoeffs<double> truth = true_light(14);
+    const RasterImages<float> raster =
+        render_with_environment(run.model, cam, truth.cast<float>(), ShadingMode::Shadowed);
+    const Image photo = fitted_colour(run, cam, raster, 0, truth);
+    std::size_t uncovered = 0;
+    for (float a : raster.alpha) uncovered += a < 0.5f;
+    ASSERT_GT(uncovered, raster.alpha.size() / 3) << "the sky must matter";
+    LightFitOptions o;
+    o.iterations = 400;
+    const LightFitResult r = fit_light(run, cam, photo, Image{}, o);
+    EXPECT_GT(r.final_psnr, 40.0);
+    EXPECT_LT(relative_error(r.sh, truth), 0.05);
+    // The same photo fitted as if the run had no sky: its sky pixels stay black and the fit cannot match.
+    run.sky_background = false;
+    EXPECT_LT(fit_light(run, cam, photo, Image{}, o).final_psnr, 25.0);
 }
 
 TEST(LightFit, RecoversANetworkLightThroughTheEmbedding) {

@@ -10,6 +10,7 @@
 #include "lumigauss/math/symmetric_eigen.h"
 #include "lumigauss/shading/sh_rotation.h"
 #include "lumigauss/util/error.h"
+#include "lumigauss/util/text.h"
 
 namespace lumigauss {
 
@@ -17,21 +18,9 @@ namespace {
 
 // "X,Y,Z" with finite numbers (spaces allowed), or none.
 std::optional<Vec3d> parse_vector(const std::string& text) {
-    Vec3d v{};
-    std::size_t at = 0;
-    for (int i = 0; i < 3; ++i) {
-        const std::size_t end = i < 2 ? text.find(',', at) : text.size();
-        if (end == std::string::npos) return std::nullopt;
-        const std::string part = text.substr(at, end - at);
-        char* stop = nullptr;
-        v[i] = std::strtod(part.c_str(), &stop);
-        while (stop && *stop == ' ') ++stop;
-        if (part.find_first_not_of(' ') == std::string::npos || !stop || *stop != '\0' ||
-            !std::isfinite(v[i]))
-            return std::nullopt;
-        at = end + 1;
-    }
-    return v;
+    const auto v = parse_number_list(text, 3);
+    if (!v) return std::nullopt;
+    return Vec3d{(*v)[0], (*v)[1], (*v)[2]};
 }
 
 // The coordinate axis nearest to `v` (by the largest component), signed.

@@ -72,12 +72,14 @@ HoldoutImageResult evaluate_view(const TrainedRun& run, const Dataset& scene, co
     r.light = fit.sh, r.light_unshadowed = fit_unshadowed.sh;
 
     // The unshadowed colour under its own light first; then everything else under the shadowed fit.
-    p.unshadowed = clamp01(
-        raster_channels(renderer.render(view.camera, r.light_unshadowed.cast<float>()), kRelitUnshadowed, 3));
+    // Each drawn as the fit saw it: over its light's sky when the run was trained with its sky behind.
+    p.unshadowed =
+        fitted_colour(run, view.camera, renderer.render(view.camera, r.light_unshadowed.cast<float>()),
+                      kRelitUnshadowed, r.light_unshadowed);
     t0 = Clock::now();
     const RasterImages<float>& relit = renderer.render(view.camera, fit.sh.cast<float>());
     r.render_ms = ms_since(t0);
-    p.shadowed = clamp01(raster_channels(relit, kRelitShadowed, 3));
+    p.shadowed = fitted_colour(run, view.camera, relit, kRelitShadowed, fit.sh);
     r.shadowed = image_metrics(p.shadowed, p.truth, p.mask, options.ssim);
     r.unshadowed = image_metrics(p.unshadowed, p.truth, p.mask, options.ssim);
     if (options.keep_panels) {

@@ -5,8 +5,12 @@
 #include <span>
 
 #include "lumigauss/io/image_metrics.h"
+#include "lumigauss/relight/relit_render.h"
+#include "lumigauss/render/background.h"
 #include "lumigauss/render/blend_weights.h"
+#include "lumigauss/render/raster_maps.h"
 #include "lumigauss/shading/irradiance.h"
+#include "lumigauss/shading/sky_image.h"
 #include "lumigauss/shading/surfel_shading.h"
 #include "lumigauss/train/adam.h"
 #include "lumigauss/train/image_losses.h"
@@ -123,6 +127,8 @@ class LightParameters {
 };
 
 // One render of the frozen model under a light, its objective and the objective's gradient w.r.t. the SH.
+// A run trained with its sky behind the surfels is rendered so here too: the sky of the light being fitted
+// fills what the surfels leave uncovered, and its pixels pull on the light as they did in training.
 class FrozenViewObjective {
   public:
     FrozenViewObjective(const TrainedRun& run, const Camera& camera, const Image& photo, const Image& mask,
@@ -140,6 +146,10 @@ class FrozenViewObjective {
         // evaluation only re-shades the surfels and composites with them (and back), which is exact.
         shade_surfels(model_, uniform_irradiance_environment<float>(), mode_, normals_, batch_);
         weights_ = render_blend_weights(camera_, batch_, settings_, images_);
+        if (run.sky_background) {
+            rays_ = pixel_ray_directions(camera_);
+            horizon_ = run.sky_horizon;
+        }
     }
 
     struct Value {
@@ -151,8 +161,13 @@ class FrozenViewObjective {
         Value v;
         shade_surfels(model_, env, mode_, normals_, batch_);
         composite(weights_, batch_.colors, batch_.channels, images_.color);
+        if (!rays_.empty()) {
+            sky_pixels(rays_, env, nullptr, sky_, horizon_);
+            composite_background<float>(images_, sky_.colour, 0);
+        }
         std::span<const float> rendered = images_.color;  // 3 channels in either single mode
         grad_.color.assign(with_gradient ? rendered.size() : 0, 0.0f);
+        grad_.alpha.clear();  // the sky's backward adds to it; the frozen geometry never reads it
         std::span<float> g = grad_.color;
         const float w1 = float(1 - o_.lambda_dssim), w2 = float(o_.lambda_dssim);
         const double l1 = masked_l1_loss<float>(shape_, rendered, photo_.pixels, mask_.pixels, w1, g);
@@ -179,6 +194,12 @@ class FrozenViewObjective {
 
   private:
     void add_render_gradient(const ShCoeffs<float>& env, ShCoeffs<float>& g_env) {
+        if (!rays_.empty()) {
+            g_sky_.assign(sky_.colour.size(), 0.0f);
+            composite_background_backward<float>(images_, sky_.colour, 0, grad_, g_sky_);
+            const SkyGrads g = sky_pixels_backward(rays_, sky_, g_sky_, {}, false);
+            for (int k = 0; k < kShCount; ++k) g_env.c[k] = g_env.c[k] + g.env.c[k];
+        }
         g_colors_.resize(batch_.colors.size());
         composite_backward(weights_, grad_.color, batch_.channels, g_colors_);
         model_.zero_grad();  // the model's own gradients are a by-product here, never used
@@ -206,12 +227,25 @@ class FrozenViewObjective {
     BlendWeights weights_;
     RasterImageGrads<float> grad_;
     std::vector<float> g_colors_;
+    std::vector<Vec3f> rays_;  // every pixel's world ray, when the sky is drawn behind; else empty
+    SkyHorizon horizon_;
+    SkyPixels sky_;
+    std::vector<float> g_sky_;
 };
 
 }  // namespace
 
 const char* light_variable_name(LightVariable v) {
     return v == LightVariable::Sh ? "sh" : "embedding";
+}
+
+Image fitted_colour(const TrainedRun& run, const Camera& camera, const RasterImages<float>& relit, int first,
+                    const ShCoeffs<double>& light) {
+    Image colour = raster_channels(relit, first, 3);
+    if (run.sky_background)
+        colour = over_background_image(colour, alpha_image(relit),
+                                       sky_image(camera, light.cast<float>(), nullptr, run.sky_horizon));
+    return clamp01(colour);
 }
 
 ShCoeffs<double> default_initial_sh(const TrainedRun& run) {

@@ -67,6 +67,12 @@ struct LightFitResult {
 LightFitResult fit_light(const TrainedRun& run, const Camera& camera, const Image& photo, const Image& mask,
                          const LightFitOptions& options);
 
+// Channels [first, first + 3) of a render (`relit`: relit_render.h's layout, or any colour raster with
+// first = 0) as the fit compares it with the photo: over the sky of `light` when the run was trained with its
+// sky behind the surfels (else over black), clamped to [0, 1].
+Image fitted_colour(const TrainedRun& run, const Camera& camera, const RasterImages<float>& relit, int first,
+                    const ShCoeffs<double>& light);
+
 // The default starting light: the mean learned SH of the run's photos, or a neutral grey environment with
 // irradiance 1 in every direction when the run has none (a bare PLY).
 ShCoeffs<double> default_initial_sh(const TrainedRun& run);
