@@ -111,9 +111,9 @@ class Progress {
     std::deque<double> psnr_;
 };
 
-// The held-out photos of a snapshot scored as `eval --protocol holdout` would at the training resolution
-// (each photo's light fitted through the network on its left half, the right half scored), with a shorter fit
-// so that a checkpoint does not wait long for it.
+// The held-out photos of a snapshot scored as `eval --protocol holdout --fit-iterations 100` scores the
+// shadowed render at the training resolution (each photo's light fitted through the network on its left
+// half, the right half scored): a shorter fit, and no unshadowed one, so that training does not wait long.
 SnapshotScorer held_out_scorer(const std::string& scene, RasterBackend backend) {
     return [scene, backend](const RunPaths& paths) -> std::optional<HeldOutScore> {
         const TrainedRun run = load_trained_run(paths.dir);
@@ -125,9 +125,10 @@ SnapshotScorer held_out_scorer(const std::string& scene, RasterBackend backend) 
         options.fit.variable = LightVariable::Embedding;
         options.fit.iterations = 100;
         options.keep_panels = false;
+        options.unshadowed = false;  // one fit per photo: the shadowed render is the model
         options.backend = backend;
         const HoldoutResult result = evaluate_holdout(run, data, options);
-        return HeldOutScore{result.images.size(), result.mean_shadowed.psnr, result.mean_unshadowed.psnr};
+        return HeldOutScore{result.images.size(), result.mean_shadowed.psnr};
     };
 }
 
@@ -233,10 +234,9 @@ int run_train(const TrainFlags& f) {
         t.densify);
     if (const HeldOutLog& h = run.last_held_out(); h.score)
         std::printf(
-            "train: %zu held-out photos: PSNR %.2f dB shadowed, %.2f unshadowed (each light fitted on the "
-            "left "
-            "half, the right half scored; %.1f s)\n",
-            h.score->photos, h.score->psnr_shadowed, h.score->psnr_unshadowed, h.seconds);
+            "train: %zu held-out photos: PSNR %.2f dB (each light fitted on the left half, the right half "
+            "scored; %.1f s)\n",
+            h.score->photos, h.score->psnr, h.seconds);
     else if (!h.error.empty())
         std::printf("train: the held-out photos could not be scored: %s\n", h.error.c_str());
     std::printf("train: model %s, lighting %s, photos %s\n", paths.model.c_str(), paths.lighting.c_str(),

@@ -45,12 +45,13 @@ const std::string& tiny_scene() {
 }
 
 // A 60-iteration run through all three stages: stage 1 to 29, stage 2 30..35, stage 3 from 36;
-// densification at 20 and 40 (30 is in stage 2), an opacity reset at 40; a log line every 5 iterations.
+// densification at 20 and 40 (30 is in stage 2), an opacity reset at 40; a log line every 5 iterations;
+// checkpoints and held-out scores every 20.
 const std::string kSchedule =
     " --preset paper-fast --iterations 60 --set warmup=30 --set start_shadowed=35 --set densify_from=10"
     " --set densify_until=50 --set densify_interval=10 --set opacity_reset_interval=40"
     " --set start_regularization=20 --set lr_position_max_steps=50 --set log_interval=5"
-    " --set checkpoint_interval=20 -q";
+    " --set checkpoint_interval=20 --set held_out_interval=20 -q";
 
 std::string train_args(const std::string& run, const std::string& extra = kSchedule) {
     return "train " + shell_quoted(tiny_scene()) + " -o " + shell_quoted(run) + extra;
@@ -199,7 +200,7 @@ TEST(CliTrain, StopAfterThenResumeIsByteIdentical) {
     EXPECT_EQ(std::set<std::int64_t>(its.begin(), its.end()).size(), its.size()) << "duplicated iterations";
     EXPECT_EQ(its, log_iterations(log_a));
     ASSERT_EQ(log_a.size(), log_b.size());
-    // The held-out photos are scored with every checkpoint (20, 40) and at the end (60), the same before and
+    // The held-out photos are scored every 20 iterations (20, 40) and at the end (60), the same before and
     // after the resume.
     std::vector<std::int64_t> scored;
     for (const auto& j : log_b)

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "lumigauss/eval/holdout.h"
@@ -109,6 +110,17 @@ TEST(Holdout, TheFittedLightReproducesTheUnseenHalf) {
         EXPECT_EQ(im.panels.shadowed.width, im.panels.truth.width);
     }
     EXPECT_GT(r.mean_shadowed.psnr, 35.0);
+
+    // Without the unshadowed fit (what `train` scores): the same shadowed scores, no unshadowed ones.
+    HoldoutOptions shadowed_only = quick_options();
+    shadowed_only.unshadowed = false;
+    const HoldoutResult s1 = evaluate_holdout(run, d, shadowed_only);
+    ASSERT_EQ(s1.images.size(), r.images.size());
+    for (std::size_t i = 0; i < r.images.size(); ++i) {
+        EXPECT_EQ(s1.images[i].shadowed.psnr, r.images[i].shadowed.psnr);
+        EXPECT_TRUE(std::isnan(s1.images[i].unshadowed.psnr));
+        EXPECT_TRUE(std::isnan(s1.images[i].fit_psnr_unshadowed));
+    }
 }
 
 TEST(Holdout, OnlyTheRightHalfIsScored) {

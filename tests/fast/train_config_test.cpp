@@ -124,7 +124,7 @@ std::vector<MemberChange> every_member() {
         {"lambda_sky_residual", [](TrainConfig& c) { c.lambda_sky_residual = 0.125; }},
         {"lr_sky_residual", [](TrainConfig& c) { c.lr_sky_residual = 0.03; }},
         {"sky_pins_light", [](TrainConfig& c) { c.sky_pins_light = false; }},
-        {"score_held_out", [](TrainConfig& c) { c.score_held_out = false; }},
+        {"held_out_interval", [](TrainConfig& c) { c.held_out_interval = 250; }},
         {"lighting_init_radiance", [](TrainConfig& c) { c.lighting_init_radiance = 0.7; }},
         {"use_sky_masks", [](TrainConfig& c) { c.use_sky_masks = false; }},
         {"lambda_sky_alpha", [](TrainConfig& c) { c.lambda_sky_alpha = 0.3; }},
@@ -208,6 +208,7 @@ TEST(TrainConfigPreset, PaperFastShrinksTheScheduleOnly) {
     EXPECT_EQ(fast.densify_interval, 100);
     EXPECT_EQ(fast.opacity_reset_interval, 600);
     EXPECT_EQ(fast.checkpoint_interval, 500);
+    EXPECT_EQ(fast.held_out_interval, 1000);
 
     // Everything else as paper: the JSONs differ in exactly the keys above.
     const Json f = Json::parse(train_config_to_json(fast));
@@ -221,6 +222,7 @@ TEST(TrainConfigPreset, PaperFastShrinksTheScheduleOnly) {
                                             "densify_from",
                                             "densify_until",
                                             "densify_interval",
+                                            "held_out_interval",
                                             "opacity_reset_interval",
                                             "checkpoint_interval",
                                             "background_alpha_from"};
@@ -639,6 +641,7 @@ TEST(TrainConfigValidate, RejectsEachBadValueNamingTheKey) {
         {"percent_dense", [](TrainConfig& c) { c.percent_dense = 0.0; }},
         {"checkpoint_interval", [](TrainConfig& c) { c.checkpoint_interval = -1; }},
         {"log_interval", [](TrainConfig& c) { c.log_interval = 0; }},
+        {"held_out_interval", [](TrainConfig& c) { c.held_out_interval = -1; }},
         {"lambda_shadow", [](TrainConfig& c) { c.lambda_shadow = std::numeric_limits<double>::quiet_NaN(); }},
         {"lr_mlp", [](TrainConfig& c) { c.lr_mlp = std::numeric_limits<double>::infinity(); }},
         {"sky_horizon_start", [](TrainConfig& c) { c.sky_horizon_start = -1; }},

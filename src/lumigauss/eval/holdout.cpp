@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 
 #include "lumigauss/relight/relit_render.h"
 #include "lumigauss/render/raster_maps.h"
@@ -65,23 +66,33 @@ HoldoutImageResult evaluate_view(const TrainedRun& run, const Dataset& scene, co
     LightFitOptions fit_options = options.fit;
     fit_options.shadowed = true;
     const LightFitResult fit = fit_light(run, view.camera, p.truth, fit_mask, fit_options);
-    fit_options.shadowed = false;
-    const LightFitResult fit_unshadowed = fit_light(run, view.camera, p.truth, fit_mask, fit_options);
-    r.fit_ms = ms_since(t0) / 2;
-    r.fit_psnr = fit.final_psnr, r.fit_psnr_unshadowed = fit_unshadowed.final_psnr;
-    r.light = fit.sh, r.light_unshadowed = fit_unshadowed.sh;
+    r.fit_psnr = fit.final_psnr;
+    r.light = fit.sh;
+    if (options.unshadowed) {
+        fit_options.shadowed = false;
+        const LightFitResult fit_unshadowed = fit_light(run, view.camera, p.truth, fit_mask, fit_options);
+        r.fit_psnr_unshadowed = fit_unshadowed.final_psnr;
+        r.light_unshadowed = fit_unshadowed.sh;
+    }
+    r.fit_ms = ms_since(t0) / (options.unshadowed ? 2 : 1);
 
     // The unshadowed colour under its own light first; then everything else under the shadowed fit.
     // Each drawn as the fit saw it: over its light's sky when the run was trained with its sky behind.
-    p.unshadowed =
-        fitted_colour(run, view.camera, renderer.render(view.camera, r.light_unshadowed.cast<float>()),
-                      kRelitUnshadowed, r.light_unshadowed);
+    if (options.unshadowed) {
+        p.unshadowed =
+            fitted_colour(run, view.camera, renderer.render(view.camera, r.light_unshadowed.cast<float>()),
+                          kRelitUnshadowed, r.light_unshadowed);
+        r.unshadowed = image_metrics(p.unshadowed, p.truth, p.mask, options.ssim);
+    } else {
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        r.fit_psnr_unshadowed = nan;
+        r.unshadowed = {nan, nan, nan, nan};
+    }
     t0 = Clock::now();
     const RasterImages<float>& relit = renderer.render(view.camera, fit.sh.cast<float>());
     r.render_ms = ms_since(t0);
     p.shadowed = fitted_colour(run, view.camera, relit, kRelitShadowed, fit.sh);
     r.shadowed = image_metrics(p.shadowed, p.truth, p.mask, options.ssim);
-    r.unshadowed = image_metrics(p.unshadowed, p.truth, p.mask, options.ssim);
     if (options.keep_panels) {
         p.albedo = clamp01(raster_channels(relit, kRelitAlbedo, 3));
         p.normal = encode_normals(relit);

@@ -34,6 +34,8 @@ struct HoldoutOptions {
     SsimOptions ssim;     // win 5, as the official evaluation
     Split views = Split::Test;
     bool keep_panels = true;
+    // false: the shadowed render only (one fit per photo instead of two); the unshadowed scores are NaN.
+    bool unshadowed = true;
     RasterBackend backend = RasterBackend::Cpu;  // the scoring renders (the fits run on the CPU)
     // Called after each photo (its result, how many are done, how many in all): each fit takes seconds, a
     // collection minutes, so the command shows them as they come.

@@ -46,8 +46,7 @@ std::string step_log_line(const StepReport& r, double elapsed_seconds, const Hel
     }
     if (r.opacity_reset) j["opacity_reset"] = true;
     if (held_out.score) {
-        j["held_out_psnr"] = held_out.score->psnr_shadowed;
-        j["held_out_psnr_unshadowed"] = held_out.score->psnr_unshadowed;
+        j["held_out_psnr"] = held_out.score->psnr;
         j["held_out_photos"] = held_out.score->photos;
         j["held_out_s"] = held_out.seconds;
     }

@@ -16,12 +16,11 @@ void save_run_model(const RunPaths& paths, const TrainState& state);
 // The scores of a run's held-out photos for one snapshot of its model: means over the photos scored.
 struct HeldOutScore {
     std::size_t photos = 0;
-    double psnr_shadowed = 0, psnr_unshadowed = 0;
+    double psnr = 0;  // of the shadowed render
 };
 
-// What scoring a snapshot adds to its iteration's log line: the score ("held_out_psnr",
-// "held_out_psnr_unshadowed", "held_out_photos") and its time ("held_out_s"), or the error of a scorer that
-// failed ("held_out_error").
+// What scoring a snapshot adds to its iteration's log line: the score ("held_out_psnr", "held_out_photos")
+// and its time ("held_out_s"), or the error of a scorer that failed ("held_out_error").
 struct HeldOutLog {
     std::optional<HeldOutScore> score;
     double seconds = 0;

@@ -107,7 +107,7 @@ constexpr std::array kFields = {
     LUMIGAUSS_FIELD(lambda_opacity),
     LUMIGAUSS_FIELD(checkpoint_interval),
     LUMIGAUSS_FIELD(log_interval),
-    LUMIGAUSS_FIELD(score_held_out),
+    LUMIGAUSS_FIELD(held_out_interval),
 };
 
 #undef LUMIGAUSS_FIELD
@@ -372,6 +372,7 @@ void shrink_schedule(TrainConfig& config) {
     config.densify_interval = 100;
     config.opacity_reset_interval = 600;
     config.checkpoint_interval = 500;
+    config.held_out_interval = 1000;
     config.background_alpha_from = 100;
 }
 
@@ -607,6 +608,7 @@ void validate_train_config(const TrainConfig& c) {
     require(c.checkpoint_interval >= 0, "checkpoint_interval", c.checkpoint_interval,
             "must be >= 0 (0 = only at the end)");
     require(c.log_interval > 0, "log_interval", c.log_interval, "must be > 0");
+    require(c.held_out_interval >= 0, "held_out_interval", c.held_out_interval, "must be >= 0 (0: never)");
 }
 
 }  // namespace lumigauss

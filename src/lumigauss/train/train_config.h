@@ -134,9 +134,10 @@ struct TrainConfig {
     // Run bookkeeping (not in the official code).
     std::int64_t checkpoint_interval = 1000;  // iterations between checkpoints; 0 = only at the end/interrupt
     std::int64_t log_interval = 10;           // iterations between log lines; every loss term is logged
-    // With every checkpoint and at the end, score the scene's held-out photos into log.jsonl (`train` uses
-    // eval's holdout protocol: each photo's light fitted on its left half, the right half scored).
-    bool score_held_out = true;
+    // Every held_out_interval iterations and at the end, score the scene's held-out photos into log.jsonl
+    // (`train` uses eval's holdout protocol: each photo's light fitted on its left half, the right half
+    // scored); 0 = never.
+    std::int64_t held_out_interval = 5000;
 };
 
 // The preset's values; throws Error for an unknown name (train_preset_names()).

@@ -139,7 +139,7 @@ double TrainingRun::elapsed_seconds() const {
 
 HeldOutLog TrainingRun::score_snapshot() {
     HeldOutLog held_out;
-    if (!scorer_ || !trainer_->state().config.score_held_out) return held_out;
+    if (!scorer_) return held_out;
     const auto t0 = std::chrono::steady_clock::now();
     try {
         held_out.score = scorer_(paths_);
@@ -175,17 +175,21 @@ TrainingOutcome TrainingRun::run(std::int64_t stop_after, const std::function<bo
             elapsed_ = elapsed();
             return TrainingOutcome::NonFinite;
         }
-        // A snapshot (every checkpoint and the end) is scored before its iteration's log line, which carries
-        // the scores, and the progress report, whose charts read the log.
-        const bool checkpoint_now = config.checkpoint_interval > 0 &&
-                                    r.iteration % config.checkpoint_interval == 0 && !trainer_->done();
-        HeldOutLog held_out;
-        if (checkpoint_now || trainer_->done()) {
+        // The held-out photos are scored on a snapshot of the model files, before the iteration's log line
+        // (which carries the scores) and the progress report (whose charts read the log).
+        const bool done = trainer_->done();
+        const bool checkpoint_now =
+            config.checkpoint_interval > 0 && r.iteration % config.checkpoint_interval == 0 && !done;
+        const bool score_now =
+            config.held_out_interval > 0 && (r.iteration % config.held_out_interval == 0 || done);
+        if (checkpoint_now || done)
             save_checkpoint_and_snapshot();
-            held_out = score_snapshot();
-        }
-        const bool log_now = r.iteration % config.log_interval == 0 || r.densify_ran || r.prune_ran ||
-                             trainer_->done() || held_out.score || !held_out.error.empty();
+        else if (score_now)
+            save_run_model(paths_, trainer_->state());
+        HeldOutLog held_out;
+        if (score_now) held_out = score_snapshot();
+        const bool log_now = r.iteration % config.log_interval == 0 || r.densify_ran || r.prune_ran || done ||
+                             held_out.score || !held_out.error.empty();
         if (log_now) log << step_log_line(r, elapsed(), held_out) << '\n' << std::flush;
         if (checkpoint_now) write_progress(paths_, *trainer_, kPreviewViews);
         on_step(r);
