@@ -4,12 +4,15 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <numbers>
 #include <string>
 
 #include "lumigauss/cameras/up_axis.h"
+#include "lumigauss/export/export_region.h"
 #include "lumigauss/export/relightable_bundle.h"
 #include "lumigauss/model/relightable_ply.h"
 #include "lumigauss/model/splat_ply.h"
@@ -106,6 +109,50 @@ TEST(CliExport, EveryFormatAndImportFromBarePly) {
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_THAT(r.output, HasSubstr("is -y"));
     EXPECT_EQ(load_2dgs_ply(tmp / "baked/turned.ply").size(), surfels);
+
+    // --crop-radius and --recentre: the surfels near the median centre, moved so that it is the origin; the
+    // colours are those of the same crop left in place (the cameras move with the surfels).
+    // The radius: the median distance of the surfels from their median centre, so that about half stay.
+    const SurfelModel model = load_relightable_ply(run_paths(t.run).model);
+    ExportRegion region;
+    region.recentre = true;
+    const Vec3d centre = apply_export_region(model, {}, region).centre;
+    std::vector<double> distances;
+    for (std::size_t i = 0; i < model.size(); ++i) {
+        const std::vector<float>& xyz = model.param(ModelParam::Xyz);
+        distances.push_back(length(Vec3d{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]} - centre));
+    }
+    std::nth_element(distances.begin(), distances.begin() + std::ptrdiff_t(distances.size() / 2),
+                     distances.end());
+    region = ExportRegion{};
+    region.radius = distances[distances.size() / 2];
+    char radius[32];
+    std::snprintf(radius, sizeof radius, "%.17g", *region.radius);
+    const std::string crop =
+        " --format ply-3dgs --crop-radius " + std::string(radius) + " --light " + shell_quoted(photos[0]);
+    r = run_lumigauss("export " + shell_quoted(t.run) + crop + " -o " + shell_quoted(tmp / "baked/crop.ply"),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("the crop keeps"));
+    r = run_lumigauss(
+        "export " + shell_quoted(t.run) + crop + " --recentre -o " + shell_quoted(tmp / "baked/centred.ply"),
+        tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("origin moved to"));
+    const ViewDependentSurfels in_place = load_2dgs_ply(tmp / "baked/crop.ply");
+    const ViewDependentSurfels centred = load_2dgs_ply(tmp / "baked/centred.ply");
+    ASSERT_EQ(in_place.size(), centred.size());
+    EXPECT_GT(in_place.size(), 0u);
+    EXPECT_LT(in_place.size(), surfels);
+    const RegionedModel expected = apply_export_region(model, {}, region);
+    EXPECT_EQ(in_place.size(), expected.model.size());
+    for (std::size_t i = 0; i < centred.size(); ++i)
+        for (int a = 0; a < 3; ++a)
+            ASSERT_NEAR(centred.surfels.means[3 * i + a],
+                        in_place.surfels.means[3 * i + a] - expected.centre[a], 1e-4);
+    for (std::size_t k = 0; k < centred.sh.size(); ++k) ASSERT_NEAR(centred.sh[k], in_place.sh[k], 1e-4);
+    expect_refused(shell_quoted(t.run) + " --format html --recentre -o " + shell_quoted(tmp / "page.html"),
+                   "not html", tmp);
 
     // spz: gzip; the run's photos' up (the synthetic scene's +z) turned to +y.
     r = run_lumigauss("export " + shell_quoted(t.run) + " --format spz --light " + shell_quoted(photos[0]) +
