@@ -32,11 +32,13 @@
 
 #include "lumigauss/cameras/camera_json.h"
 #include "lumigauss/cameras/up_axis.h"
+#include "lumigauss/io/image.h"
 #include "lumigauss/model/relightable_ply.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_source.h"
 #include "lumigauss/relight/relit_render.h"
 #include "lumigauss/render/raster_maps.h"
+#include "lumigauss/shading/envmap.h"
 #include "lumigauss/shading/sh_text.h"
 #include "lumigauss/viewer/http_server.h"
 #include "lumigauss/viewer/model_payload.h"
@@ -434,7 +436,8 @@ TEST(CliViewBrowser, RendersWithoutErrorsAndMatchesTheCppRenderer) {
     EXPECT_GT(r["nonblank_fraction"].get<double>(), 0.01) << "the orbit frames are blank";
     for (const auto& [name, ok] : r["controls"].items()) EXPECT_TRUE(ok.get<bool>()) << "control " << name;
     EXPECT_GE(r["controls"].size(), 12u);
-    for (const char* control : {"drop_sh_file", "panel_toggle", "loading_hidden"})
+    for (const char* control :
+         {"drop_sh_file", "drop_panorama", "hdr_flat_equals_rle", "panel_toggle", "loading_hidden"})
         EXPECT_TRUE(r["controls"].contains(control)) << control;
     std::printf("  %s, %s target: frame median %.1f ms\n", r["renderer"].get<std::string>().c_str(),
                 r["float_target"].get<bool>() ? "float" : "8-bit", r["frame_ms"]["median"].get<double>());
@@ -447,6 +450,25 @@ TEST(CliViewBrowser, RendersWithoutErrorsAndMatchesTheCppRenderer) {
     const ShCoeffs<double> want = rotate_about_up(sh, {0, 0, 1}, rc["degrees"].get<double>());
     for (int k = 0; k < kShCount; ++k)
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(rc["rotated"][k][c].get<double>(), want.c[k][c], 1e-12) << k;
+
+    // The dropped panorama lights the page with the SH the C++ projects from the same file about the same up
+    // (the page decoded the .hdr itself), and the page's panorama frames are the C++ ones.
+    const nlohmann::json& pc = r["panorama_check"];
+    ASSERT_TRUE(pc.is_object()) << r.dump(2);
+    const std::vector<unsigned char> hdr = base64_decode(pc["hdr_base64"]);
+    std::ofstream(tmp / "dropped.hdr", std::ios::binary)
+        .write(reinterpret_cast<const char*>(hdr.data()), std::streamsize(hdr.size()));
+    const Vec3d page_up{pc["up"][0], pc["up"][1], pc["up"][2]};
+    const ShCoeffs<double> projected =
+        project_panorama_to_sh(read_image(tmp / "dropped.hdr"), panorama_frame_for_up(page_up));
+    for (int k = 0; k < kShCount; ++k)
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(pc["sh"][k][c].get<double>(), projected.c[k][c], 1e-9) << k;
+    for (const nlohmann::json& f : pc["frames"]) {
+        const Mat3d frame = panorama_frame_for_up({f["up"][0], f["up"][1], f["up"][2]});
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+                EXPECT_NEAR(f["frame"][i][j].get<double>(), frame(i, j), 1e-12) << f.dump();
+    }
 
     // Every view from the fixed camera. The page computes in float like the C++ (same formulas); what differs
     // is rounding (GPU exp/pow, half-float blending, 8-bit read-back), so colours agree to about 1/255:

@@ -9,6 +9,7 @@ import { decodePayload, packSplats } from './model.js';
 import { OrbitCamera, parseCameraParam } from './orbit.js';
 import { SplatRenderer } from './renderer.js';
 import { MODES } from './shaders.js';
+import { decodePanoramaFile, panoramaFrameForUp, parseRadianceHdr, projectPanoramaToSh } from './panorama.js';
 import { parseShText, rotateAboutUp, scaleSh } from './sh.js';
 
 const NEAR = 0.2;  // render/raster_constants.h kNearPlane
@@ -132,6 +133,32 @@ async function fetchOk(url) {
 }
 
 const nextFrame = () => new Promise((resolve) => requestAnimationFrame(resolve));
+
+// A 16 x 8 Radiance .hdr panorama for the control checks (flat, or run-length coded scanlines as most
+// files are), with radiance that varies across rows and columns and a brighter zenith.
+function testPanoramaHdr(rle) {
+  const W = 16, H = 8;
+  const header = `#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y ${H} +X ${W}\n`;
+  const rgbe = [];
+  for (let y = 0; y < H; ++y)
+    for (let x = 0; x < W; ++x) {
+      const v = [0.2 + 0.1 * y, 0.5 + 0.4 * Math.sin(x), (y === 0 ? 3 : 1) + x / 16];
+      const e = Math.floor(Math.log2(Math.max(...v))) + 1;
+      rgbe.push(...v.map((c) => Math.floor((c * 256) / 2 ** e)), e + 128);
+    }
+  const out = [...header].map((ch) => ch.charCodeAt(0));
+  if (!rle) return new Uint8Array(out.concat(rgbe));
+  for (let y = 0; y < H; ++y) {
+    out.push(2, 2, W >> 8, W & 255);
+    for (let c = 0; c < 4; ++c) {
+      const line = [];
+      for (let x = 0; x < W; ++x) line.push(rgbe[4 * (y * W + x) + c]);
+      if (line.every((v) => v === line[0])) out.push(128 + W, line[0]);  // a run
+      else out.push(W, ...line);  // a literal
+    }
+  }
+  return new Uint8Array(out);
+}
 
 function percentile(values, q) {
   if (!values.length) return null;
@@ -292,7 +319,7 @@ class Viewer {
       document.body.classList.toggle('collapsed');
       this.dirty = true;
     };
-    // An SH file dropped on the view lights the model, as the file input does.
+    // An SH file or a panorama dropped on the view lights the model, as the file input does.
     const view = $('view');
     view.addEventListener('dragover', (e) => {
       e.preventDefault();
@@ -302,7 +329,7 @@ class Viewer {
     view.addEventListener('drop', (e) => {
       e.preventDefault();
       view.classList.remove('dropping');
-      if (e.dataTransfer && e.dataTransfer.files.length) this.loadShFile(e.dataTransfer.files[0]);
+      if (e.dataTransfer && e.dataTransfer.files.length) this.loadLightFile(e.dataTransfer.files[0]);
     });
     const touch = () => (this.dirty = true);
     $('light').onchange = (e) => { this.lightIndex = Number(e.target.value); this.updateEnvironment(); };
@@ -321,16 +348,19 @@ class Viewer {
     $('background').value = this.sky ? 'sky' : 'black';
     $('background').onchange = (e) => { this.sky = e.target.value === 'sky'; touch(); };
     $('reset').onclick = () => { this.camera.reset(); touch(); };
-    $('shfile').onchange = (e) => this.loadShFile(e.target.files[0]);
+    $('shfile').onchange = (e) => this.loadLightFile(e.target.files[0]);
     this.bindPointer($('canvas'));
     window.addEventListener('resize', touch);
   }
 
-  async loadShFile(file) {
+  // An SH text file, or a panorama (.hdr, .png, .jpg) projected to SH about the scene's up as the C++ does.
+  async loadLightFile(file) {
     if (!file) return;
     try {
-      const sh = parseShText(await file.text());
-      this.lights.push({ name: file.name, kind: 'SH file', sh, local: true });
+      const panorama = /\.(hdr|exr|png|jpe?g)$/i.test(file.name);
+      const sh = panorama ? projectPanoramaToSh(await decodePanoramaFile(file), panoramaFrameForUp(this.scene.up))
+                          : parseShText(await file.text());
+      this.lights.push({ name: file.name, kind: panorama ? 'panorama' : 'SH file', sh, local: true });
       this.lightIndex = this.lights.length - 1;
       this.fillLightMenu();
       this.updateEnvironment();
@@ -444,7 +474,7 @@ class Viewer {
     const file = new DataTransfer();
     file.items.add(new File(['1 1 1\n0 0 0\n0.5 0.5 0.5\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n'], 'test_sh.txt'));
     $('shfile').files = file.files;
-    await this.loadShFile($('shfile').files[0]);
+    await this.loadLightFile($('shfile').files[0]);
     checks.sh_file = this.lights[this.lightIndex].name === 'test_sh.txt' && this.env[6] === 0.5 * 2;
     const canvas = $('canvas'), az = this.camera.azimuth, dist = this.camera.distance;
     const pointer = (type, x, extra = {}) =>
@@ -463,6 +493,23 @@ class Viewer {
     $('view').dispatchEvent(new DragEvent('drop', { dataTransfer: dropped, cancelable: true }));
     for (let i = 0; i < 50 && this.lights[this.lightIndex].name !== 'dropped_sh.txt'; ++i) await nextFrame();
     checks.drop_sh_file = this.lights[this.lightIndex].name === 'dropped_sh.txt';
+    this.lights.pop();
+    this.lightIndex = this.lights.length - 1;
+    // A panorama dropped on the view, the same pixels in a flat and a run-length coded .hdr file.
+    const flat = testPanoramaHdr(false), rle = testPanoramaHdr(true);
+    const pano = new DataTransfer();
+    pano.items.add(new File([rle], 'test_sky.hdr'));
+    $('view').dispatchEvent(new DragEvent('drop', { dataTransfer: pano, cancelable: true }));
+    for (let i = 0; i < 50 && this.lights[this.lightIndex].name !== 'test_sky.hdr'; ++i) await nextFrame();
+    const light = this.lights[this.lightIndex];
+    checks.drop_panorama = light.name === 'test_sky.hdr' && light.kind === 'panorama';
+    const a = parseRadianceHdr(flat).pixels, b = parseRadianceHdr(rle).pixels;
+    checks.hdr_flat_equals_rle = a.length === b.length && a.every((v, i) => v === b[i]);
+    const ups = [this.scene.up, [0, -1, 0], [0.2, -0.9, 0.3], [-1, 0.1, 0]];
+    this.panoramaCheck = {
+      up: this.scene.up, sh: light.sh, hdr_base64: btoa(String.fromCharCode(...rle)),
+      frames: ups.map((up) => ({ up, frame: panoramaFrameForUp(up) })),
+    };
     this.lights.pop();
     this.lightIndex = this.lights.length - 1;  // the SH file loaded above, removed below
     // The panel toggle, twice; the loading indicator is gone once the viewer runs.
@@ -500,6 +547,7 @@ class Viewer {
     if (params.has('controls')) {
       this.bindControls();
       report.controls = await this.checkControls();
+      report.panorama_check = this.panoramaCheck;
     }
     const degrees = Number(params.get('rot') || 0);
     this.rotation = degrees;
