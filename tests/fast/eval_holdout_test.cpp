@@ -111,6 +111,14 @@ TEST(Holdout, TheFittedLightReproducesTheUnseenHalf) {
     }
     EXPECT_GT(r.mean_shadowed.psnr, 35.0);
 
+    // At most one photo: the first of the split, scored as before.
+    HoldoutOptions one = quick_options();
+    one.max_views = 1;
+    const HoldoutResult first = evaluate_holdout(run, d, one);
+    ASSERT_EQ(first.images.size(), 1u);
+    EXPECT_EQ(first.images[0].name, r.images[0].name);
+    EXPECT_EQ(first.images[0].shadowed.psnr, r.images[0].shadowed.psnr);
+
     // Without the unshadowed fit (what `train` scores): the same shadowed scores, no unshadowed ones.
     HoldoutOptions shadowed_only = quick_options();
     shadowed_only.unshadowed = false;

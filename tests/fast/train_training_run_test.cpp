@@ -201,9 +201,10 @@ std::vector<nlohmann::json> log_lines(const std::string& path) {
 TEST(TrainingRun, HeldOutScoresGoIntoTheLogEveryInterval) {
     TempDir tmp("training_run_held_out");
     TrainingRunRequest r = request(tmp / "run", 25);
-    r.config.checkpoint_interval =
-        0;  // only at the end: the scored snapshots at 10 and 20 are model files only
+    // Checkpoints only at the end: the scored snapshots at 10 and 20 are model files only.
+    r.config.checkpoint_interval = 0;
     r.config.held_out_interval = 10;
+    r.config.warmup = 4, r.config.start_shadowed = 5;  // scored in the shadowed stage: from iteration 6
     r.config.log_interval = 4;      // 10 and 25 are not logged iterations: scoring logs them anyway
     std::vector<std::size_t> seen;  // the surfel count of each scored snapshot
     r.score_snapshot = [&](const RunPaths& paths) -> std::optional<HeldOutScore> {
@@ -244,6 +245,7 @@ TEST(TrainingRun, AFailingScorerIsReportedOnceAndTrainingGoesOn) {
     TempDir tmp("training_run_scorer_fails");
     TrainingRunRequest r = request(tmp / "run", 25);
     r.config.held_out_interval = 10;
+    r.config.warmup = 4, r.config.start_shadowed = 5;
     int calls = 0;
     r.score_snapshot = [&](const RunPaths&) -> std::optional<HeldOutScore> {
         ++calls;

@@ -120,9 +120,13 @@ HoldoutResult evaluate_holdout(const TrainedRun& run, const Dataset& scene, cons
     result.variable = options.fit.variable;
     result.iterations = options.fit.iterations;
     result.views = options.views;
-    const std::vector<const View*> views = scene.split(options.views);
-    if (views.empty())
+    const std::vector<const View*> all = scene.split(options.views);
+    if (all.empty())
         throw Error(scene.root + ": the scene has no " + split_name(options.views) + " image to evaluate");
+    // At most max_views, spread evenly over the split (the first always among them).
+    std::vector<const View*> views;
+    const std::size_t count = options.max_views > 0 ? std::min(options.max_views, all.size()) : all.size();
+    for (std::size_t i = 0; i < count; ++i) views.push_back(all[i * all.size() / count]);
     RelitRenderer renderer(run.model, options.backend);
     std::vector<double> fit_ms, render_ms;
     for (const View* v : views) {

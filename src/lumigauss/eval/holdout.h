@@ -36,6 +36,8 @@ struct HoldoutOptions {
     bool keep_panels = true;
     // false: the shadowed render only (one fit per photo instead of two); the unshadowed scores are NaN.
     bool unshadowed = true;
+    // > 0: at most this many photos of the split, spread evenly over it (views i * count / max_views).
+    std::size_t max_views = 0;
     RasterBackend backend = RasterBackend::Cpu;  // the scoring renders (the fits run on the CPU)
     // Called after each photo (its result, how many are done, how many in all): each fit takes seconds, a
     // collection minutes, so the command shows them as they come.

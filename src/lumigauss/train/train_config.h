@@ -134,9 +134,9 @@ struct TrainConfig {
     // Run bookkeeping (not in the official code).
     std::int64_t checkpoint_interval = 1000;  // iterations between checkpoints; 0 = only at the end/interrupt
     std::int64_t log_interval = 10;           // iterations between log lines; every loss term is logged
-    // Every held_out_interval iterations and at the end, score the scene's held-out photos into log.jsonl
-    // (`train` uses eval's holdout protocol: each photo's light fitted on its left half, the right half
-    // scored); 0 = never.
+    // Every held_out_interval iterations of the shadowed stage and at the end, score the scene's held-out
+    // photos into log.jsonl (`train` uses eval's holdout protocol: each photo's light fitted on its left
+    // half, the right half scored); 0 = never.
     std::int64_t held_out_interval = 5000;
 };
 

@@ -180,8 +180,10 @@ TrainingOutcome TrainingRun::run(std::int64_t stop_after, const std::function<bo
         const bool done = trainer_->done();
         const bool checkpoint_now =
             config.checkpoint_interval > 0 && r.iteration % config.checkpoint_interval == 0 && !done;
+        // Before the shadowed stage the shadowed render (what is scored) is not trained yet: the end only.
         const bool score_now =
-            config.held_out_interval > 0 && (r.iteration % config.held_out_interval == 0 || done);
+            config.held_out_interval > 0 &&
+            ((r.iteration % config.held_out_interval == 0 && r.iteration > config.start_shadowed) || done);
         if (checkpoint_now || done)
             save_checkpoint_and_snapshot();
         else if (score_now)

@@ -33,8 +33,9 @@ struct TrainingRunRequest {
     // A new run's split override (DatasetOptions::test_every): set, every n-th photo is a test photo (0:
     // none). A resumed run keeps the split it recorded (scene.json).
     std::optional<int> test_every;
-    // Called every config.held_out_interval iterations and at the end (never when it is 0), once the model
-    // files of that iteration are written; its scores go into log.jsonl with that iteration's line
+    // Called every config.held_out_interval iterations of the shadowed stage and at the end (never when it is
+    // 0), once the model files of that iteration are written; its scores go into log.jsonl with that
+    // iteration's line
     // ("held_out_psnr", "held_out_photos", "held_out_s"). One that throws is reported in the log
     // ("held_out_error") and not called again: scoring never stops a training run.
     SnapshotScorer score_snapshot;
