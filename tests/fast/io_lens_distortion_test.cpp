@@ -47,7 +47,28 @@ TEST(LensDistortion, KnownAnswersOfColmapModels) {
     EXPECT_TRUE(lens_of("PINHOLE", {500, 510, 320, 240}).is_identity());
     EXPECT_TRUE(lens_of("SIMPLE_RADIAL", {500, 320, 240, 0}).is_identity());
     LensDistortion unused;
-    EXPECT_FALSE(colmap_lens_distortion("OPENCV_FISHEYE", {500, 510, 320, 240, 0, 0, 0, 0}, unused));
+    EXPECT_FALSE(colmap_lens_distortion("THIN_PRISM_FISHEYE", std::vector<double>(12, 0.0), unused));
+}
+
+// COLMAP's fisheyes (models.h, FisheyeCameraModel): theta = atan(r), theta_d = theta (1 + k1 theta^2 + ...),
+// the point scaled by theta_d / r.
+TEST(LensDistortion, KnownAnswersOfColmapFisheyeModels) {
+    const double u = 0.3, v = -0.2, r = std::hypot(u, v), t = std::atan(r), t2 = t * t;
+    // OPENCV_FISHEYE fx fy cx cy k1 k2 k3 k4
+    Vec2<double> q = lens_of("OPENCV_FISHEYE", {500, 510, 320, 240, 0.1, -0.05, 0.01, 0.002}).distort({u, v});
+    const double td = t * (1 + 0.1 * t2 - 0.05 * t2 * t2 + 0.01 * t2 * t2 * t2 + 0.002 * t2 * t2 * t2 * t2);
+    EXPECT_NEAR(q.x, u * td / r, 1e-15);
+    EXPECT_NEAR(q.y, v * td / r, 1e-15);
+    // SIMPLE_RADIAL_FISHEYE f cx cy k; RADIAL_FISHEYE f cx cy k1 k2
+    q = lens_of("SIMPLE_RADIAL_FISHEYE", {500, 320, 240, 0.1}).distort({u, v});
+    EXPECT_NEAR(q.x, u * t * (1 + 0.1 * t2) / r, 1e-15);
+    q = lens_of("RADIAL_FISHEYE", {500, 320, 240, 0.1, -0.05}).distort({u, v});
+    EXPECT_NEAR(q.y, v * t * (1 + 0.1 * t2 - 0.05 * t2 * t2) / r, 1e-15);
+    // An equidistant lens without terms still bends rays: it is no pinhole. Its centre stays.
+    const LensDistortion plain = lens_of("OPENCV_FISHEYE", {500, 510, 320, 240, 0, 0, 0, 0});
+    EXPECT_FALSE(plain.is_identity());
+    EXPECT_NEAR(plain.distort({u, v}).x, u * t / r, 1e-15);
+    EXPECT_EQ(plain.distort({0, 0}).x, 0.0);
 }
 
 // A smooth picture of the world as the ideal pinhole sees it, by normalized coordinates.
@@ -117,6 +138,18 @@ TEST(LensDistortion, UndistortingAPhotoGivesThePinholePicture) {
     const LensDistortion opencv = lens_of("OPENCV", {80, 82, 47.0, 37.5, -0.1, 0.02, 0.004, -0.003});
     EXPECT_LT(undistortion_error(c, opencv, covered), 0.01);
     EXPECT_GT(undistortion_error(c, opencv, covered, LensDistortion{}), 0.03)
+        << "the comparison must see the lens";
+}
+
+// A fisheye photo undistorted onto the pinhole of the same focal length: every pinhole ray is in the photo
+// (the fisheye sees wider) and the picture comes back.
+TEST(LensDistortion, AFisheyePhotoUndistortsToThePinholePicture) {
+    const Camera c = test_camera();
+    const LensDistortion fisheye = lens_of("OPENCV_FISHEYE", {80, 82, 47.0, 37.5, 0.05, -0.01, 0.002, 0.0});
+    int covered = 0;
+    EXPECT_LT(undistortion_error(c, fisheye, covered), 0.01);
+    EXPECT_EQ(covered, c.width * c.height);
+    EXPECT_GT(undistortion_error(c, fisheye, covered, LensDistortion{}), 0.03)
         << "the comparison must see the lens";
 }
 
@@ -194,13 +227,30 @@ TEST(DatasetColmap, DistortedCamerasAreUndistortedOnLoad) {
     EXPECT_EQ(small.pixels, resize_area(undistort_image(photo, c, lens), c.width / 2, c.height / 2).pixels);
 }
 
-TEST(DatasetColmap, ANonPolynomialLensIsRefusedWithTheFix) {
+TEST(DatasetColmap, AnUnhandledLensIsRefusedWithTheFix) {
     TempDir tmp;
     ColmapModel m = test::small_model(2, 8, 6);
-    m.cameras[2] = ColmapCamera{2, "OPENCV_FISHEYE", 8, 6, {25, 25, 4, 3, 0.1, 0, 0, 0}};
+    m.cameras[2] = ColmapCamera{2, "THIN_PRISM_FISHEYE", 8, 6, {25, 25, 4, 3, 0.1, 0, 0, 0, 0, 0, 0, 0}};
     test::write_scene(tmp.path(), m);
     expect_error([&] { load_dataset(tmp.path().string()); },
-                 {"cameras.txt", "camera_id 2", "OPENCV_FISHEYE", "colmap image_undistorter", "masks/"});
+                 {"cameras.txt", "camera_id 2", "THIN_PRISM_FISHEYE", "colmap image_undistorter", "masks/"});
+}
+
+// The one-focal fisheye models take f, cx, cy as the pinhole's intrinsics.
+TEST(DatasetColmap, FisheyeCamerasLoadWithTheirIntrinsics) {
+    TempDir tmp;
+    ColmapModel m = test::small_model(2, 8, 6);
+    m.cameras[2] = ColmapCamera{2, "SIMPLE_RADIAL_FISHEYE", 8, 6, {25, 4.5, 3.25, 0.1}};
+    test::write_scene(tmp.path(), m);
+    const Dataset d = load_dataset(tmp.path().string());
+    const View& v = d.views[1];
+    EXPECT_EQ(v.camera.fx, 25.0);
+    EXPECT_EQ(v.camera.fy, 25.0);
+    EXPECT_EQ(v.camera.cx, 4.5);
+    EXPECT_EQ(v.camera.cy, 3.25);
+    EXPECT_TRUE(v.lens.fisheye);
+    EXPECT_EQ(v.lens.k1, 0.1);
+    EXPECT_EQ(d.undistorted_views(), 1u);
 }
 
 }  // namespace

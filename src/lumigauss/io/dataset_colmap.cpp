@@ -35,10 +35,12 @@ Camera pinhole_camera(const ColmapCamera& c, const std::string& file, LensDistor
     if (!colmap_lens_distortion(c.model, p, lens))
         fail_in_file(file, "camera_id " + std::to_string(c.id) + " uses the " + c.model +
                                " model, which LumiGauss does not undistort (it does SIMPLE_RADIAL, RADIAL, "
-                               "OPENCV and FULL_OPENCV). Run `colmap image_undistorter --image_path images "
+                               "OPENCV, FULL_OPENCV and the SIMPLE_RADIAL, RADIAL and OPENCV fisheyes). Run "
+                               "`colmap image_undistorter --image_path images "
                                "--input_path sparse/0 --output_path undistorted` and use the `undistorted` "
                                "folder as the scene (copy masks/ and sky_masks/ through the same step)");
-    const bool one_focal = c.model == "SIMPLE_PINHOLE" || c.model == "SIMPLE_RADIAL" || c.model == "RADIAL";
+    const bool one_focal = c.model == "SIMPLE_PINHOLE" || c.model == "SIMPLE_RADIAL" || c.model == "RADIAL" ||
+                           c.model == "SIMPLE_RADIAL_FISHEYE" || c.model == "RADIAL_FISHEYE";
     if (one_focal)
         cam.fx = cam.fy = p[0], cam.cx = p[1], cam.cy = p[2];
     else

@@ -13,6 +13,19 @@ double radial_factor(const LensDistortion& d, double r2) {
     return numerator / denominator;
 }
 
+// theta_d / theta of the fisheye polynomial.
+double fisheye_factor(const LensDistortion& d, double theta) {
+    const double t2 = theta * theta;
+    return 1 + t2 * (d.k1 + t2 * (d.k2 + t2 * (d.k3 + t2 * d.k4)));
+}
+
+// How far from the centre the lens puts a ray of radius r (radial terms only).
+double image_radius(const LensDistortion& d, double r) {
+    if (!d.fisheye) return r * radial_factor(d, r * r);
+    const double theta = std::atan(r);
+    return theta * fisheye_factor(d, theta);
+}
+
 // The pinhole image's normalized point at the centre of pixel (x, y) (centres at +0.5).
 Vec2<double> pixel_ray(const Camera& c, int x, int y) {
     return {(x + 0.5 - c.cx) / c.fx, (y + 0.5 - c.cy) / c.fy};
@@ -32,9 +45,9 @@ double fold_radius(const Camera& c, const LensDistortion& d) {
     double previous = 0;
     for (int i = 1; i <= steps; ++i) {
         const double r = i * dr;
-        const double image_radius = r * radial_factor(d, r * r);
-        if (!(image_radius > previous)) return (i - 1) * dr;
-        previous = image_radius;
+        const double radius = image_radius(d, r);
+        if (!(radius > previous)) return (i - 1) * dr;
+        previous = radius;
     }
     return INFINITY;
 }
@@ -61,10 +74,16 @@ bool source_position(const Camera& c, const LensDistortion& d, double fold, int 
 }  // namespace
 
 bool LensDistortion::is_identity() const {
-    return k1 == 0 && k2 == 0 && k3 == 0 && k4 == 0 && k5 == 0 && k6 == 0 && p1 == 0 && p2 == 0;
+    return !fisheye && k1 == 0 && k2 == 0 && k3 == 0 && k4 == 0 && k5 == 0 && k6 == 0 && p1 == 0 && p2 == 0;
 }
 
 Vec2<double> LensDistortion::distort(Vec2<double> p) const {
+    if (fisheye) {
+        const double r = std::hypot(p.x, p.y);
+        if (!(r > 1e-12)) return p;  // the centre, where theta_d / r -> 1
+        const double theta = std::atan(r);
+        return (theta * fisheye_factor(*this, theta) / r) * p;
+    }
     const double u = p.x, v = p.y, r2 = u * u + v * v;
     const double R = radial_factor(*this, r2);
     return {u * R + 2 * p1 * u * v + p2 * (r2 + 2 * u * u), v * R + 2 * p2 * u * v + p1 * (r2 + 2 * v * v)};
@@ -82,6 +101,13 @@ bool colmap_lens_distortion(const std::string& model, const std::vector<double>&
     } else if (model == "OPENCV" || model == "FULL_OPENCV") {
         out.k1 = at(4), out.k2 = at(5), out.p1 = at(6), out.p2 = at(7);
         if (model == "FULL_OPENCV") out.k3 = at(8), out.k4 = at(9), out.k5 = at(10), out.k6 = at(11);
+    } else if (model == "SIMPLE_RADIAL_FISHEYE" || model == "RADIAL_FISHEYE") {
+        out.fisheye = true;
+        out.k1 = at(3);
+        if (model == "RADIAL_FISHEYE") out.k2 = at(4);
+    } else if (model == "OPENCV_FISHEYE") {
+        out.fisheye = true;
+        out.k1 = at(4), out.k2 = at(5), out.k3 = at(6), out.k4 = at(7);
     } else {
         return false;
     }
