@@ -124,9 +124,13 @@ void run_export(const ExportOptions& o) {
                     " shapes a baked light (ply-3dgs, compressed-ply, glb, spz, splat); " + o.format +
                     " bakes none" +
                     (o.format == "html" ? " (the page has rotation and exposure sliders)" : ""));
-    // glTF is y-up by definition, as SPZ is.
-    const ExportOrientation orientation =
-        o.format == "glb" ? ExportOrientation::YUp : parse_export_orientation(o.orient);
+    // glTF is y-up by definition, as SPZ is. SuperSplat turns every PLY it opens by 180 degrees about z (PLY
+    // content has -y up, its PlayCanvas world +y: playcanvas/supersplat#451), so the compressed PLY, read by
+    // little else, is y-down unless --orient says otherwise.
+    const ExportOrientation orientation = o.format == "glb" ? ExportOrientation::YUp
+                                          : o.format == "compressed-ply" && !o.orient_given
+                                              ? ExportOrientation::YDown
+                                              : parse_export_orientation(o.orient);
     if (o.orient_given && o.format != "ply-3dgs" && o.format != "compressed-ply" && o.format != "splat")
         throw Error(
             "--orient is for --format ply-3dgs, compressed-ply and splat (" + o.format +
@@ -268,9 +272,12 @@ void register_export(CLI::App& app) {
                o->orient = orient;
                o->orient_given = true;
            },
-           "ply-3dgs, compressed-ply, splat: none (default: the world as trained), y-up (--up turned to +y, "
-           "for y-up viewers and engines) or y-down (--up turned to -y: the COLMAP / Inria 3DGS convention "
-           "most splat viewers assume)")
+           "ply-3dgs, compressed-ply, splat: none (the world as trained; the default but for "
+           "compressed-ply), "
+           "y-up (--up turned to +y, for y-up viewers and engines) or y-down (--up turned to -y: the COLMAP "
+           "/ "
+           "Inria 3DGS convention most splat viewers assume; compressed-ply's default, upright in "
+           "SuperSplat)")
         ->type_name("TEXT");
     cmd->add_option("--crop-radius", o->crop_radius,
                     "model formats: keep the surfels within R (world units) of the region's centre (the "

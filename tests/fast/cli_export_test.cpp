@@ -27,6 +27,7 @@ namespace {
 using synth_test::TempDir;
 using testing::CommandResult;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using testing::run_lumigauss;
 using testing::shell_quoted;
 namespace fs = std::filesystem;
@@ -165,13 +166,18 @@ TEST(CliExport, EveryFormatAndImportFromBarePly) {
     EXPECT_EQ(std::uint8_t(spz[0]), 0x1f);
     EXPECT_EQ(std::uint8_t(spz[1]), 0x8b);
 
-    // compressed-ply (export_compressed_ply_test.cpp reads it): degree 1, y-down, 16 + 9 bytes per surfel.
-    r = run_lumigauss("export " + shell_quoted(t.run) +
-                          " --format compressed-ply --sh-degree 1 --orient y-down " + "--light " +
+    // compressed-ply (export_compressed_ply_test.cpp reads it): degree 1, y-down by default (SuperSplat turns
+    // a PLY by 180 degrees about z), 16 + 9 bytes per surfel; --orient none keeps the world.
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format compressed-ply --sh-degree 1 --light " +
                           shell_quoted(photos[0]) + " -o " + shell_quoted(tmp / "m.compressed.ply"),
                       tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_THAT(r.output, HasSubstr("is -y"));
+    r = run_lumigauss("export " + shell_quoted(t.run) + " --format compressed-ply --orient none --light " +
+                          shell_quoted(photos[0]) + " -o " + shell_quoted(tmp / "world.compressed.ply"),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, Not(HasSubstr("turned")));
     const std::string compressed = synth_test::read_bytes(tmp / "m.compressed.ply");
     const std::size_t body = compressed.size() - (compressed.find("end_header\n") + 11);
     EXPECT_EQ(body, 72 * ((surfels + 255) / 256) + (16 + 9) * surfels);
