@@ -146,9 +146,7 @@ GtEnvImageResult evaluate_view(Evaluation& e, const View& v, const GtEnvResult& 
     const int w = v.camera.width, h = v.camera.height;
 
     const double k = result.light.scale;
-    const ShCoeffs<double> truth = load_condition_sh(e.meta, im->condition);
-    ShCoeffs<float> env;
-    for (int j = 0; j < kShCount; ++j) env.c[j] = (truth.c[j] * (k * im->exposure)).cast<float>();
+    const ShCoeffs<float> env = scaled_true_env(e.meta, *im, {k, k, k});
     const auto t0 = std::chrono::steady_clock::now();
     const RasterImages<float>& relit = e.renderer.render(v.camera, env);
     r.render_ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

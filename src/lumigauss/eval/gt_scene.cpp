@@ -115,7 +115,8 @@ ShCoeffs<float> scaled_true_env(const GtSceneMeta& meta, const GtImageMeta& im,
     const ShCoeffs<double> truth = load_condition_sh(meta, im.condition);
     ShCoeffs<float> env;
     for (int j = 0; j < kShCount; ++j)
-        for (int c = 0; c < 3; ++c) env.c[j][c] = float(truth.c[j][c] * scale[std::size_t(c)] * im.exposure);
+        for (int c = 0; c < 3; ++c)
+            env.c[j][c] = float(truth.c[j][c] * (scale[std::size_t(c)] * im.exposure));
     return env;
 }
 
