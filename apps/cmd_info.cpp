@@ -6,6 +6,7 @@
 
 #include "commands.h"
 #include "lumigauss/io/dataset.h"
+#include "lumigauss/io/exif_notes.h"
 #include "lumigauss/io/scene_extent.h"
 
 namespace lumigauss::cli {
@@ -17,6 +18,7 @@ struct InfoOptions {
     int downscale = 1;
     std::string masks = "transient";
     bool quiet = false;
+    bool photos = false;
 };
 
 // "128x96 (20), 64x48 (3)": distinct values with how many views have each.
@@ -45,6 +47,7 @@ void print_views(const Dataset& d, const std::string& mask_mode) {
             "lens:          %zu views with lens distortion, undistorted as they load onto the pinhole of "
             "the same intrinsics (pixels the photo does not cover are masked out)\n",
             d.undistorted_views());
+    for (const std::string& note : exif_notes(d)) std::printf("exif:          %s\n", note.c_str());
     std::printf("masks:         %d of %zu views", masks, d.views.size());
     if (masks > 0)
         std::printf(", taken as %s\n", mask_mode == "object"
@@ -84,6 +87,28 @@ void print_extent(const Dataset& d) {
                 double(b.min.y), double(b.min.z), double(b.max.x), double(b.max.y), double(b.max.z));
 }
 
+// One line per photo: split, size, what its EXIF said (orientation and whether it was applied, exposure).
+void print_photos(const Dataset& d) {
+    std::printf("photos:        name, split, size, EXIF orientation, exposure time, f-number, ISO, EV100\n");
+    for (const View& v : d.views) {
+        const PhotoExif& e = v.exif;
+        const auto value = [](const std::optional<double>& x, const char* format) {
+            char text[32] = "-";
+            if (x) std::snprintf(text, sizeof text, format, *x);
+            return std::string(text);
+        };
+        const std::string orientation =
+            e.orientation == 1 ? "1"
+                               : std::to_string(e.orientation) +
+                                     (v.image_orientation != 1 ? " (turned upright)" : " (as stored)");
+        std::printf("  %s  %s  %dx%d  %s  %s  %s  %s  %s%s%s\n", v.name.c_str(), split_name(v.split),
+                    v.camera.width, v.camera.height, orientation.c_str(),
+                    value(e.exposure_time_s, "%.6gs").c_str(), value(e.f_number, "f/%.3g").c_str(),
+                    value(e.iso, "%.6g").c_str(), value(e.ev100(), "%.2f").c_str(),
+                    e.problem.empty() ? "" : "  EXIF unreadable: ", e.problem.c_str());
+    }
+}
+
 void run_info(const InfoOptions& o) {
     DatasetOptions options;
     options.downscale = o.downscale;
@@ -97,6 +122,7 @@ void run_info(const InfoOptions& o) {
     std::printf("scene:         %s\nformat:        %s\n", d.root.c_str(), d.format.c_str());
     print_views(d, o.masks);
     print_extent(d);
+    if (o.photos) print_photos(d);
 }
 
 }  // namespace
@@ -113,6 +139,8 @@ void register_info(CLI::App& app) {
     cmd->add_option("--masks", options->masks, "How train takes the masks: transient (default) or object")
         ->check(CLI::IsMember({"transient", "object"}));
     cmd->add_flag("-q,--quiet", options->quiet, "print one summary line");
+    cmd->add_flag("--photos", options->photos,
+                  "also one line per photo: split, size, EXIF orientation and exposure (EV100)");
     cmd->callback([options] { run_info(*options); });
 }
 

@@ -196,6 +196,7 @@ int run_train(const TrainFlags& f) {
             "train: %zu photos have lens distortion: undistorted onto their pinhole camera as they load "
             "(pixels the photo does not cover are masked out)\n",
             run.undistorted_photos());
+    for (const std::string& note : run.exif_notes()) std::printf("train: %s\n", note.c_str());
     if (run.far_points_dropped() > 0)
         std::printf(
             "train: dropped %zu SfM point(s) more than %.4g from the cameras' centre (1000x their "

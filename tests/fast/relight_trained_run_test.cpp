@@ -86,9 +86,9 @@ TEST(RelightTrainedRun, SkyHorizonIsTheTrainingCamerasMeanUpWithTheConfigAngles)
     // vertical; a held-out photo looking straight down must not count.
     SceneRecord record;
     record.scene = "/nowhere", record.format = "colmap-text";
-    record.photos.push_back({"x.png", "train", {1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 0}});
-    record.photos.push_back({"y.png", "train", {0, 0, -1, 0, 1, 0, 1, 0, 0}, {0, 0, 0}});
-    record.photos.push_back({"t.png", "test", {1, 0, 0, 0, 0, 1, 0, -1, 0}, {0, 0, 0}});
+    record.photos.push_back({"x.png", "train", {1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 0}, {}, false});
+    record.photos.push_back({"y.png", "train", {0, 0, -1, 0, 1, 0, 1, 0, 0}, {0, 0, 0}, {}, false});
+    record.photos.push_back({"t.png", "test", {1, 0, 0, 0, 0, 1, 0, -1, 0}, {0, 0, 0}, {}, false});
     save_scene_record(run_paths(dir).scene, record);
     const SkyHorizon h = load_trained_run(dir).sky_horizon;
     EXPECT_EQ(h.start_degrees, 3.0f);

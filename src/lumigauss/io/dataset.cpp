@@ -4,8 +4,10 @@
 #include <cmath>
 #include <filesystem>
 #include <set>
+#include <tuple>
 
 #include "lumigauss/io/dataset_detail.h"
+#include "lumigauss/io/image_orientation.h"
 #include "lumigauss/io/scene_extent.h"
 #include "lumigauss/util/error.h"
 
@@ -29,23 +31,54 @@ bool same_aspect_smaller(int width, int height, const Camera& camera) {
     return std::abs(expected_height - height) <= 1.0 && std::abs(expected_width - width) <= 1.0;
 }
 
-// Checks the files of a view; returns true when its camera was scaled to a smaller photo.
+bool fits_camera(int width, int height, const Camera& camera) {
+    return (width == camera.width && height == camera.height) || same_aspect_smaller(width, height, camera);
+}
+
+// The orientation the photo's pixels are used in: as stored (COLMAP's way, whatever the tag says) unless only
+// the upright photo fits the camera.
+int orientation_to_apply(const ImageInfo& stored, const View& v) {
+    if (!orientation_swaps_axes(v.exif.orientation) || fits_camera(stored.width, stored.height, v.camera))
+        return 1;
+    return fits_camera(stored.height, stored.width, v.camera) ? v.exif.orientation : 1;
+}
+
+// A mask made from the stored photo is turned with it; one of the upright photo's size is used as it is.
+int mask_orientation_for(const ImageInfo& mask, const ImageInfo& stored, int image_orientation) {
+    if (image_orientation == 1 || mask.width != stored.width || mask.height != stored.height) return 1;
+    return image_orientation;
+}
+
+ImageInfo upright_info(ImageInfo info, int orientation) {
+    if (orientation_swaps_axes(orientation)) std::swap(info.width, info.height);
+    return info;
+}
+
+// Checks the files of a view and reads its EXIF; returns true when its camera was scaled to a smaller photo.
 bool check_files(RawView& raw) {
     View& v = raw.view;
-    const ImageInfo image = read_image_info(v.image_path);
+    const ImageInfo stored = read_image_info(v.image_path);
+    v.exif = read_photo_exif(v.image_path);
+    v.image_orientation = orientation_to_apply(stored, v);
+    const ImageInfo image = upright_info(stored, v.image_orientation);
     bool fitted = false;
     if (same_aspect_smaller(image.width, image.height, v.camera)) {
         v.camera = v.camera.resized(image.width, image.height);
         fitted = true;
     }
     if (image.width != v.camera.width || image.height != v.camera.height)
-        fail_in_file(v.image_path, "image is " + size_text(image.width, image.height) + " but its camera (" +
-                                       raw.camera_origin + ") is " +
-                                       size_text(v.camera.width, v.camera.height));
-    for (const auto& [path, kind] :
-         {std::pair{v.mask_path, "mask"}, std::pair{v.sky_mask_path, "sky mask"}}) {
+        fail_in_file(v.image_path,
+                     "image is " + size_text(image.width, image.height) +
+                         (v.image_orientation != 1 ? " once turned upright by its EXIF orientation" : "") +
+                         " but its camera (" + raw.camera_origin + ") is " +
+                         size_text(v.camera.width, v.camera.height));
+    for (auto [path, kind, orientation] :
+         {std::tuple{v.mask_path, "mask", &v.mask_orientation},
+          std::tuple{v.sky_mask_path, "sky mask", &v.sky_mask_orientation}}) {
         if (path.empty()) continue;
-        const ImageInfo mask = read_image_info(path);
+        const ImageInfo stored_mask = read_image_info(path);
+        *orientation = mask_orientation_for(stored_mask, stored, v.image_orientation);
+        const ImageInfo mask = upright_info(stored_mask, *orientation);
         if (mask.width != image.width || mask.height != image.height)
             fail_in_file(path, std::string(kind) + " is " + size_text(mask.width, mask.height) +
                                    " but its image " + v.image_path + " is " +
@@ -62,9 +95,13 @@ void check_unique_names(const std::vector<RawView>& views) {
 }
 
 // Full-resolution file size must match the camera before anything is downscaled.
-View finish_view(RawView raw, int factor, std::size_t& fitted) {
-    if (check_files(raw)) ++fitted;
+View finish_view(RawView raw, int factor, Dataset& d) {
+    if (check_files(raw)) ++d.cameras_fitted_to_photos;
     View v = raw.view;
+    if (v.image_orientation != 1)
+        ++d.photos_turned_upright;
+    else if (v.exif.orientation != 1)
+        ++d.orientation_tags_not_applied;
     v.source_width = v.camera.width;
     v.source_height = v.camera.height;
     v.camera =
@@ -74,7 +111,8 @@ View finish_view(RawView raw, int factor, std::size_t& fitted) {
 
 // The loaded image at the view's resolution, after checking that the file has the size its header had:
 // undistorted at the photo's resolution, then downscaled.
-Image fit_to_view(Image image, const View& view, const std::string& path, const char* kind) {
+Image fit_to_view(Image image, int orientation, const View& view, const std::string& path, const char* kind) {
+    if (orientation != 1) image = upright_image(image, orientation);
     if (image.width != view.source_width || image.height != view.source_height)
         fail_in_file(path, std::string(kind) + " is " + size_text(image.width, image.height) + " but " +
                                view.name + " needs " + size_text(view.source_width, view.source_height));
@@ -103,7 +141,8 @@ int downscaled_size(int size, int factor) {
 }
 
 Image Dataset::load_image(const View& view) const {
-    return fit_to_view(to_channels(read_image(view.image_path), 3), view, view.image_path, "image");
+    return fit_to_view(to_channels(read_image(view.image_path), 3), view.image_orientation, view,
+                       view.image_path, "image");
 }
 
 Image Dataset::load_mask(const View& view) const {
@@ -111,12 +150,14 @@ Image Dataset::load_mask(const View& view) const {
     if (view.mask_path.empty())
         return view.lens.is_identity() ? Image(view.camera.width, view.camera.height, 1, 1.0f)
                                        : load_coverage(view);
-    return fit_to_view(to_channels(read_image(view.mask_path), 1), view, view.mask_path, "mask");
+    return fit_to_view(to_channels(read_image(view.mask_path), 1), view.mask_orientation, view,
+                       view.mask_path, "mask");
 }
 
 Image Dataset::load_sky_mask(const View& view) const {
     if (view.sky_mask_path.empty()) return Image();
-    return fit_to_view(to_channels(read_image(view.sky_mask_path), 1), view, view.sky_mask_path, "sky mask");
+    return fit_to_view(to_channels(read_image(view.sky_mask_path), 1), view.sky_mask_orientation, view,
+                       view.sky_mask_path, "sky mask");
 }
 
 Image Dataset::load_coverage(const View& view) const {
@@ -197,7 +238,7 @@ Dataset load_dataset(const std::string& root, const DatasetOptions& options) {
     d.point_rgb = std::move(raw.point_rgb);
     d.points_path = std::move(raw.points_path);
     d.views.reserve(raw.views.size());
-    for (const RawView& r : raw.views) d.views.push_back(finish_view(r, f, d.cameras_fitted_to_photos));
+    for (const RawView& r : raw.views) d.views.push_back(finish_view(r, f, d));
     drop_far_points(d);
     return d;
 }

@@ -22,6 +22,7 @@
 #include "lumigauss/io/camera.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/io/lens_distortion.h"
+#include "lumigauss/io/photo_exif.h"
 #include "lumigauss/math/vec.h"
 
 namespace lumigauss {
@@ -51,7 +52,14 @@ struct View {
     // the image and masks onto `camera`, and load_mask is 0 where the photo does not hold the pixel's ray.
     LensDistortion lens;
     Split split = Split::Train;
-    int source_width = 0, source_height = 0;  // the image file's size, before downscaling
+    int source_width = 0, source_height = 0;  // the camera's size before downscaling (the upright photo's)
+    // The photo's EXIF (orientation, exposure; io/photo_exif.h).
+    PhotoExif exif;
+    // The EXIF orientations the load_* functions apply to the image and mask files (1: the pixels as stored).
+    // COLMAP calibrates the stored pixels whatever the tag says, so a photo is turned upright only when its
+    // tag swaps width and height and only the upright photo has its camera's size (its poses came from a
+    // tool that applied the tag); a mask is turned with it when it has the stored photo's size.
+    int image_orientation = 1, mask_orientation = 1, sky_mask_orientation = 1;
 };
 
 inline constexpr double kFarPointRadii = 1000.0;
@@ -73,6 +81,9 @@ struct Dataset {
     // photos): their camera was scaled to the photo (Camera::resized) before any -r downscale.
     std::size_t cameras_fitted_to_photos = 0;
     double far_point_limit = 0;  // the distance from the cameras' centroid beyond which they were dropped
+    // Views turned upright by their EXIF orientation (View::image_orientation != 1), and views whose tag
+    // says to turn them but whose stored pixels have their camera's size (used as stored, as COLMAP does).
+    std::size_t photos_turned_upright = 0, orientation_tags_not_applied = 0;
 
     // RGB in [0, 1] (gray is replicated, alpha dropped), undistorted (View::lens), resized by the downscale
     // factor. Throws Error naming

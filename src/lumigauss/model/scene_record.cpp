@@ -30,6 +30,34 @@ std::array<double, N> numbers(const Json& j, const char* key, const std::string&
     return out;
 }
 
+bool has_exif(const PhotoExif& e) {
+    return e.orientation != 1 || e.exposure_time_s || e.f_number || e.iso;
+}
+
+Json exif_json(const RecordedPhoto& p) {
+    Json j{{"orientation", p.exif.orientation}, {"turned_upright", p.turned_upright}};
+    if (p.exif.exposure_time_s) j["exposure_time_s"] = *p.exif.exposure_time_s;
+    if (p.exif.f_number) j["f_number"] = *p.exif.f_number;
+    if (p.exif.iso) j["iso"] = *p.exif.iso;
+    if (const std::optional<double> ev = p.exif.ev100()) j["ev100"] = *ev;
+    return j;
+}
+
+// The logged EXIF of a photo; what is missing or not a number stays unknown (the log is informative only).
+void read_exif_json(const Json& j, RecordedPhoto& p) {
+    if (!j.is_object()) return;
+    const auto number = [&](const char* key) -> std::optional<double> {
+        if (j.contains(key) && j[key].is_number()) return j[key].get<double>();
+        return std::nullopt;
+    };
+    if (const auto o = number("orientation"); o && *o >= 1 && *o <= 8) p.exif.orientation = int(*o);
+    if (j.contains("turned_upright") && j["turned_upright"].is_boolean())
+        p.turned_upright = j["turned_upright"].get<bool>();
+    p.exif.exposure_time_s = number("exposure_time_s");
+    p.exif.f_number = number("f_number");
+    p.exif.iso = number("iso");
+}
+
 bool close(double a, double b) {
     return std::abs(a - b) <= 1e-4 * (1.0 + std::max(std::abs(a), std::abs(b)));
 }
@@ -50,6 +78,9 @@ SceneRecord scene_record_of(const Dataset& scene) {
             for (int j = 0; j < 3; ++j) p.rotation[std::size_t(3 * i + j)] = v.camera.rotation(i, j);
             p.translation[std::size_t(i)] = v.camera.translation[i];
         }
+        p.exif = v.exif;
+        p.exif.problem.clear();
+        p.turned_upright = v.image_orientation != 1;
         r.photos.push_back(std::move(p));
     }
     return r;
@@ -57,9 +88,12 @@ SceneRecord scene_record_of(const Dataset& scene) {
 
 void save_scene_record(const std::string& path, const SceneRecord& record) {
     Json photos = Json::array();
-    for (const RecordedPhoto& p : record.photos)
-        photos.push_back(
-            {{"name", p.name}, {"split", p.split}, {"rotation", p.rotation}, {"translation", p.translation}});
+    for (const RecordedPhoto& p : record.photos) {
+        Json photo{
+            {"name", p.name}, {"split", p.split}, {"rotation", p.rotation}, {"translation", p.translation}};
+        if (has_exif(p.exif)) photo["exif"] = exif_json(p);
+        photos.push_back(std::move(photo));
+    }
     const Json j{{"scene", record.scene}, {"format", record.format}, {"photos", photos}};
     write_file_atomically(path, j.dump(1) + "\n");
 }
@@ -82,6 +116,7 @@ std::optional<SceneRecord> load_scene_record(const std::string& path) {
         if (e.contains("split") && e["split"].is_string()) p.split = e["split"].get<std::string>();
         p.rotation = numbers<9>(e, "rotation", path);
         p.translation = numbers<3>(e, "translation", path);
+        if (e.contains("exif")) read_exif_json(e["exif"], p);
         r.photos.push_back(std::move(p));
     }
     return r;

@@ -6,9 +6,11 @@
 //
 //   {"scene": "/abs/path", "format": "colmap-text",
 //    "photos": [{"name": "a.png", "split": "train", "rotation": [9, row-major world-to-camera],
-//                "translation": [3]}, ...]}
+//                "translation": [3], "exif": {...}}, ...]}
 //
-// Only poses are recorded, not intrinsics or image sizes: they change with -r, the poses do not.
+// Only poses are recorded, not intrinsics or image sizes: they change with -r, the poses do not. "exif" (only
+// for photos with EXIF) logs what the photo's EXIF said and what was done with it: "orientation" (the tag),
+// "turned_upright" (whether it was applied), "exposure_time_s", "f_number", "iso", "ev100" (those known).
 #include <array>
 #include <optional>
 #include <string>
@@ -22,6 +24,8 @@ struct RecordedPhoto {
     std::string name, split;
     std::array<double, 9> rotation{};
     std::array<double, 3> translation{};
+    PhotoExif exif;               // what the photo's EXIF said (defaults when it had none)
+    bool turned_upright = false;  // its orientation tag was applied (View::image_orientation)
 };
 
 struct SceneRecord {

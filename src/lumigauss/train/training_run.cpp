@@ -11,6 +11,7 @@
 
 #include "lumigauss/io/atomic_file.h"
 #include "lumigauss/io/dataset.h"
+#include "lumigauss/io/exif_notes.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/model/render_model.h"
 #include "lumigauss/model/scene_record.h"
@@ -113,6 +114,7 @@ TrainingRun::TrainingRun(const TrainingRunRequest& request)
         far_points_dropped_ = data.far_points_dropped;
         cameras_fitted_ = data.cameras_fitted_to_photos;
         undistorted_ = data.undistorted_views();
+        exif_notes_ = lumigauss::exif_notes(data);
         far_point_limit_ = data.far_point_limit;
         trainer_ = std::make_unique<Trainer>(load_train_views(data), data.point_xyz, data.point_rgb, config);
         std::filesystem::create_directories(request.out);  // only once the input is known to be good

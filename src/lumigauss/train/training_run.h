@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "lumigauss/model/run_files.h"
 #include "lumigauss/render/rasterizer.h"
@@ -74,6 +75,8 @@ class TrainingRun {
         return undistorted_;
     }  // Dataset::undistorted_views, of a new run
     double far_point_limit() const { return far_point_limit_; }
+    // What the photos' EXIF meant (io/exif_notes.h), of a new run.
+    const std::vector<std::string>& exif_notes() const { return exif_notes_; }
     // The message of the non-finite value that ended run() (TrainingOutcome::NonFinite).
     const std::string& failure() const { return failure_; }
     double elapsed_seconds() const;  // in run(), this process
@@ -91,6 +94,7 @@ class TrainingRun {
     std::size_t sfm_points_ = 0, held_out_photos_ = 0;
     std::string auto_note_;
     std::size_t far_points_dropped_ = 0, cameras_fitted_ = 0, undistorted_ = 0;
+    std::vector<std::string> exif_notes_;
     double far_point_limit_ = 0;
     std::string failure_;
     double elapsed_ = 0;
