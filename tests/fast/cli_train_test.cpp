@@ -1,6 +1,7 @@
-// `lumigauss train`: a short run on the tiny synthetic scene writes every run file, --stop-after then
-// --resume reproduces the straight run byte for byte, an existing run is protected unless --resume or
-// --force is given, and bad input fails with a message naming the file or key.
+// `lumigauss train`: a short run on the tiny synthetic scene writes every run file, the held-out scores are
+// the holdout protocol's, an existing run is protected unless --resume or --force is given, and bad input
+// fails with a message naming the file or key. --stop-after then --resume:
+// tests/slow/cli_train_resume_test.cpp.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_train_test_util.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/model/lighting_mlp.h"
 #include "lumigauss/model/relightable_ply.h"
@@ -34,59 +36,7 @@ using testing::run_lumigauss;
 using testing::shell_quoted;
 namespace fs = std::filesystem;
 
-// The tiny scene, generated once per test process.
-const std::string& tiny_scene() {
-    static TempDir dir("cli_train_scene");
-    static const std::string root = [] {
-        synth::generate_synthetic_scene(synth_test::tiny_options(dir.str()));
-        return dir.str();
-    }();
-    return root;
-}
-
-// A 60-iteration run through all three stages: stage 1 to 29, stage 2 30..35, stage 3 from 36;
-// densification at 20 and 40 (30 is in stage 2), an opacity reset at 40; a log line every 5 iterations;
-// checkpoints and held-out scores every 20.
-const std::string kSchedule =
-    " --preset paper-fast --iterations 60 --set warmup=30 --set start_shadowed=35 --set densify_from=10"
-    " --set densify_until=50 --set densify_interval=10 --set opacity_reset_interval=40"
-    " --set start_regularization=20 --set lr_position_max_steps=50 --set log_interval=5"
-    " --set checkpoint_interval=20 --set held_out_interval=20 -q";
-
-std::string train_args(const std::string& run, const std::string& extra = kSchedule) {
-    return "train " + shell_quoted(tiny_scene()) + " -o " + shell_quoted(run) + extra;
-}
-
-const std::vector<std::string> kRunFiles = {"config.json", "log.jsonl",      "checkpoint.lgck",
-                                            "model.ply",   "lighting.lgmlp", "appearance.json"};
-
-std::vector<nlohmann::json> read_log(const std::string& path) {
-    std::ifstream in(path);
-    std::vector<nlohmann::json> lines;
-    std::string line;
-    while (std::getline(in, line)) {
-        nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
-        EXPECT_FALSE(j.is_discarded()) << "not JSON: " << line;
-        EXPECT_TRUE(j.is_object()) << line;
-        lines.push_back(std::move(j));
-    }
-    return lines;
-}
-
-std::vector<std::int64_t> log_iterations(const std::vector<nlohmann::json>& log) {
-    std::vector<std::int64_t> its;
-    for (const auto& j : log) its.push_back(j.value("iteration", std::int64_t(-1)));
-    return its;
-}
-
-// Every file under a folder (relative path) with its bytes.
-std::map<std::string, std::string> folder_bytes(const std::string& dir) {
-    std::map<std::string, std::string> files;
-    for (const auto& e : fs::recursive_directory_iterator(dir))
-        if (e.is_regular_file())
-            files[fs::relative(e.path(), dir).string()] = synth_test::read_bytes(e.path().string());
-    return files;
-}
+using namespace cli_train_test;
 
 // ---- 7. A run writes every file ----------------------------------------------------------------------
 
@@ -155,61 +105,6 @@ TEST(CliTrain, ShortRunWritesEveryRunFile) {
     EXPECT_EQ(state.iteration, 60);
     EXPECT_EQ(state.model.size(), model.size());
     EXPECT_EQ(state.image_names, train_names);
-}
-
-// ---- 8. --stop-after then --resume is the straight run ----------------------------------------------------
-
-TEST(CliTrain, StopAfterThenResumeIsByteIdentical) {
-    TempDir tmp("cli_train_resume");
-    const std::string straight = tmp / "straight", split = tmp / "split";
-    const CommandResult a = run_lumigauss(train_args(straight), tmp);
-    ASSERT_EQ(a.exit_code, 0) << a.output;
-
-    const CommandResult b = run_lumigauss(train_args(split, kSchedule + " --stop-after 25"), tmp);
-    ASSERT_EQ(b.exit_code, 0) << b.output;
-    EXPECT_THAT(b.output, HasSubstr("--resume"));
-    EXPECT_EQ(load_checkpoint(split + "/checkpoint.lgck").iteration, 25);
-    // As after a crash between a log line and the next checkpoint: lines past the checkpoint are dropped
-    // on resume.
-    {
-        std::ofstream log(split + "/log.jsonl", std::ios::app);
-        log << R"({"iteration":30,"stage":2,"total":123})" << '\n';
-    }
-    const CommandResult c = run_lumigauss(
-        "train " + shell_quoted(tiny_scene()) + " -o " + shell_quoted(split) + " --resume -q", tmp);
-    ASSERT_EQ(c.exit_code, 0) << c.output;
-    EXPECT_THAT(c.output, HasSubstr("resuming"));
-
-    // Every file but the log (which holds timings): model, lighting, checkpoint, photos, config, previews.
-    auto files_a = folder_bytes(straight), files_b = folder_bytes(split);
-    for (const std::string& f : kRunFiles) EXPECT_EQ(files_b.count(f), 1u) << f;
-    // Not the run's state: the log and progress.html hold timings, and progress/ holds a picture per
-    // checkpoint, so the stopped run has one more.
-    for (auto* files : {&files_a, &files_b})
-        std::erase_if(*files, [](const auto& f) {
-            return f.first == "log.jsonl" || f.first == "progress.html" || f.first.starts_with("progress/");
-        });
-    EXPECT_EQ(files_a.size(), files_b.size());
-    for (const auto& [name, bytes] : files_a)
-        EXPECT_TRUE(files_b.count(name) == 1 && files_b.at(name) == bytes)
-            << name << " differs between the straight and the resumed run";
-
-    std::vector<nlohmann::json> log_a = read_log(straight + "/log.jsonl");
-    std::vector<nlohmann::json> log_b = read_log(split + "/log.jsonl");
-    const std::vector<std::int64_t> its = log_iterations(log_b);
-    EXPECT_EQ(std::set<std::int64_t>(its.begin(), its.end()).size(), its.size()) << "duplicated iterations";
-    EXPECT_EQ(its, log_iterations(log_a));
-    ASSERT_EQ(log_a.size(), log_b.size());
-    // The held-out photos are scored every 20 iterations of the shadowed stage (40; not 20, before it) and at
-    // the end (60), the same before and after the resume.
-    std::vector<std::int64_t> scored;
-    for (const auto& j : log_b)
-        if (j.contains("held_out_psnr")) scored.push_back(j["iteration"]);
-    EXPECT_EQ(scored, (std::vector<std::int64_t>{40, 60}));
-    for (std::size_t i = 0; i < log_a.size(); ++i) {
-        for (auto* line : {&log_a[i], &log_b[i]}) line->erase("elapsed_s"), line->erase("held_out_s");
-        EXPECT_EQ(log_a[i], log_b[i]);
-    }
 }
 
 // The held-out photos are scored as `eval --protocol holdout --fit-iterations 100` scores them: the last log
