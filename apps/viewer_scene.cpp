@@ -38,12 +38,12 @@ std::vector<Camera> known_cameras(const ViewerSceneOptions& o) {
     return cams;
 }
 
-// --up, or for "auto" the up of the known cameras, else of the training photos the run recorded, else +z
-// (a bare PLY).
+// --up, or for "auto" the up of the known cameras, else the run's scene_up (its training photos and the
+// ground in its surfels), else +z (a bare PLY).
 Vec3d resolve_up(const ViewerSceneOptions& o, const std::vector<Camera>& cams, const TrainedRun& run) {
     if (o.up != "auto") return parse_up_axis(o.up);
     if (!cams.empty()) return estimate_up_axis(cams);
-    return run.photos_up.value_or(Vec3d{0, 0, 1});
+    return run.scene_up.value_or(Vec3d{0, 0, 1});
 }
 
 }  // namespace

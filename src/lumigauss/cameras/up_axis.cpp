@@ -7,6 +7,7 @@
 #include <numbers>
 #include <optional>
 
+#include "lumigauss/cameras/ground_plane.h"
 #include "lumigauss/math/symmetric_eigen.h"
 #include "lumigauss/shading/sh_rotation.h"
 #include "lumigauss/util/error.h"
@@ -82,11 +83,33 @@ Vec3d camera_up_direction(const std::vector<Mat3d>& world_to_camera) {
     return dot(up, mean) < 0 ? -1.0 * up : up;
 }
 
-Vec3d estimate_up_axis(const std::vector<Camera>& cameras) {
+Vec3d scene_up_direction(const std::vector<Mat3d>& world_to_camera, const std::vector<Vec3d>& camera_centres,
+                         const std::vector<Vec3d>& points) {
+    const Vec3d cameras_up = camera_up_direction(world_to_camera);
+    if (!(length(cameras_up) > 0) || points.empty()) return cameras_up;
+    const GroundPlane ground = find_ground_plane(points, camera_centres, cameras_up);
+    if (!ground.found) return cameras_up;
+    // sum x x^T + w (I - n n^T): its smallest eigenvector.
+    const double w = kGroundUpWeight * double(world_to_camera.size());
+    Mat3d m{};
+    for (const Mat3d& r : world_to_camera) {
+        const Vec3d x = r.row(0);
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) m(i, j) += x[i] * x[j];
+    }
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            m(i, j) += w * ((i == j ? 1.0 : 0.0) - ground.normal[i] * ground.normal[j]);
+    const Vec3d up = symmetric_eigen(m).vectors[0];
+    return dot(up, cameras_up) < 0 ? -1.0 * up : up;
+}
+
+Vec3d estimate_up_axis(const std::vector<Camera>& cameras, const std::vector<Vec3d>& points) {
     if (cameras.empty()) throw Error("up axis auto: no camera to estimate it from");
     std::vector<Mat3d> rotations;
-    for (const Camera& c : cameras) rotations.push_back(c.rotation);
-    const Vec3d up = camera_up_direction(rotations);
+    std::vector<Vec3d> centres;
+    for (const Camera& c : cameras) rotations.push_back(c.rotation), centres.push_back(c.center());
+    const Vec3d up = scene_up_direction(rotations, centres, points);
     if (!(length(up) > 0))
         throw Error("up axis auto: the cameras' up vectors cancel out; give --up explicitly");
     return up;

@@ -56,6 +56,13 @@ Vec3f SurfelModel::raw_albedo(std::size_t i) const {
     return {a[3 * i], a[3 * i + 1], a[3 * i + 2]};
 }
 
+std::vector<Vec3d> SurfelModel::centres() const {
+    const std::vector<float>& xyz = param(ModelParam::Xyz);
+    std::vector<Vec3d> out(size());
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
+    return out;
+}
+
 Vec3f SurfelModel::normal(std::size_t i) const {
     const Mat3f rot = rotation_from_unit_quaternion(unit_quaternion(i));
     return {rot.m[0][2], rot.m[1][2], rot.m[2][2]};

@@ -53,6 +53,7 @@ class SurfelModel {
     Vec4f unit_quaternion(std::size_t i) const;
     Vec3f raw_albedo(std::size_t i) const;  // before albedo_activation (shading/surfel_shading.h)
     Vec3f normal(std::size_t i) const;
+    std::vector<Vec3d> centres() const;  // every surfel's position
 
     // Geometry and opacity as the rasterizer takes them (exp scales, sigmoid opacity, raw quaternions).
     // Colours are left to the caller: batch.colors is resized to batch.channels per surfel, not written.

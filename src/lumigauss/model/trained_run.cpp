@@ -106,6 +106,8 @@ TrainedRun load_trained_run(const std::string& dir) {
     }
     const RecordedTrainingCameras cameras = recorded_training_cameras(dir);
     run.photos_up = photos_up_of(cameras);
+    if (run.photos_up)
+        run.scene_up = scene_up_direction(cameras.rotations, cameras.centres, run.model.centres());
     run.photo_centres = cameras.centres;
     if (fs::exists(run.paths.config)) {
         const nlohmann::json c = nlohmann::json::parse(read_text_file(run.paths.config), nullptr, false);

@@ -27,6 +27,9 @@ struct TrainedRun {
     // The world's up as the training photos that scene.json records give it (camera_up_direction); none
     // without the record (a bare PLY, a run of an older version).
     std::optional<Vec3d> photos_up;
+    // The up for --up auto: photos_up refined by the ground under those cameras in the surfels
+    // (scene_up_direction, cameras/up_axis.h); none without photos_up. photos_up stays the trained sky's.
+    std::optional<Vec3d> scene_up;
     // The centres of the cameras of those training photos (empty without the record): which side of each
     // surfel the photos saw, for exports that hold one colour per surfel.
     std::vector<Vec3d> photo_centres;

@@ -58,6 +58,13 @@ Vec3d model_centre(const SurfelModel& model) {
     return point_cloud_centre(points);
 }
 
+// The scene's SfM points, where the ground that refines the photos' up is found (cameras/up_axis.h).
+std::vector<Vec3d> sfm_points(const Dataset& scene) {
+    std::vector<Vec3d> points;
+    for (const Vec3f& p : scene.point_xyz) points.push_back({p.x, p.y, p.z});
+    return points;
+}
+
 std::string fmt(const char* format, double v) {
     char buf[64];
     std::snprintf(buf, sizeof buf, format, v);
@@ -82,6 +89,7 @@ RelightCameras relight_cameras(const RelightJob& job, const TrainedRun& run) {
                                             downscaled_size(c.camera.height, job.downscale));
         std::vector<Camera> plain;
         for (const NamedCamera& c : rc.cameras) plain.push_back(c.camera);
+        // A camera file is a path someone designed (an orbit, a fly-through): its own up, without the ground.
         rc.up = job.up == "auto" ? estimate_up_axis(plain) : parse_up_axis(job.up);
         rc.cameras = filter_views(std::move(rc.cameras), {}, job.views, job.cameras);
         return rc;
@@ -94,7 +102,7 @@ RelightCameras relight_cameras(const RelightJob& job, const TrainedRun& run) {
     if (scene.views.empty()) throw Error(scene_dir + ": the scene has no view");
     std::vector<Camera> all;
     for (const View& v : scene.views) all.push_back(v.camera);
-    rc.up = job.up == "auto" ? estimate_up_axis(all) : parse_up_axis(job.up);
+    rc.up = job.up == "auto" ? estimate_up_axis(all, sfm_points(scene)) : parse_up_axis(job.up);
     if (job.cameras == "orbit") {
         rc.orbit = true;
         if (job.orbit_frames < 1) throw Error("--frames must be at least 1");
