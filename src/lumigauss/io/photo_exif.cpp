@@ -161,6 +161,8 @@ class MemoryStream final : public ByteStream {
   public:
     explicit MemoryStream(std::span<const std::uint8_t> bytes) : bytes_(bytes) {}
     bool read(std::uint8_t* out, std::size_t n) override {
+        if (n == 0)
+            return true;  // `out` may be the null data() of an empty vector (found by fuzz.photo_exif)
         if (n > bytes_.size() - at_) return false;
         std::memcpy(out, bytes_.data() + at_, n);
         at_ += n;
@@ -181,6 +183,7 @@ class FileStream final : public ByteStream {
   public:
     explicit FileStream(std::ifstream& in) : in_(in) {}
     bool read(std::uint8_t* out, std::size_t n) override {
+        if (n == 0) return true;
         in_.read(reinterpret_cast<char*>(out), std::streamsize(n));
         return std::size_t(in_.gcount()) == n;
     }
