@@ -87,6 +87,17 @@ void print_extent(const Dataset& d) {
                 double(b.min.y), double(b.min.z), double(b.max.x), double(b.max.y), double(b.max.z));
 }
 
+// "1/250 s" below a second, "2.5 s" above, "-" when unknown.
+std::string exposure_time(const std::optional<double>& seconds) {
+    if (!seconds) return "-";
+    char text[32];
+    if (*seconds < 1)
+        std::snprintf(text, sizeof text, "1/%.4g s", 1.0 / *seconds);
+    else
+        std::snprintf(text, sizeof text, "%.4g s", *seconds);
+    return text;
+}
+
 // One line per photo: split, size, what its EXIF said (orientation and whether it was applied, exposure).
 void print_photos(const Dataset& d) {
     std::printf("photos:        name, split, size, EXIF orientation, exposure time, f-number, ISO, EV100\n");
@@ -103,7 +114,7 @@ void print_photos(const Dataset& d) {
                                      (v.image_orientation != 1 ? " (turned upright)" : " (as stored)");
         std::printf("  %s  %s  %dx%d  %s  %s  %s  %s  %s%s%s\n", v.name.c_str(), split_name(v.split),
                     v.camera.width, v.camera.height, orientation.c_str(),
-                    value(e.exposure_time_s, "%.6gs").c_str(), value(e.f_number, "f/%.3g").c_str(),
+                    exposure_time(e.exposure_time_s).c_str(), value(e.f_number, "f/%.3g").c_str(),
                     value(e.iso, "%.6g").c_str(), value(e.ev100(), "%.2f").c_str(),
                     e.problem.empty() ? "" : "  EXIF unreadable: ", e.problem.c_str());
     }

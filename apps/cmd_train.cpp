@@ -197,6 +197,14 @@ int run_train(const TrainFlags& f) {
             "(pixels the photo does not cover are masked out)\n",
             run.undistorted_photos());
     for (const std::string& note : run.exif_notes()) std::printf("train: %s\n", note.c_str());
+    if (!run.resumed() && config.exif_exposure) {
+        const std::vector<float>& k = trainer.exposures();
+        const auto [lo, hi] = std::minmax_element(k.begin(), k.end());
+        std::printf(
+            "train: exif_exposure: each photo's light is its EXIF exposure relative to the mean (x%.3g to "
+            "x%.3g) times the lighting network's output\n",
+            double(*lo), double(*hi));
+    }
     if (run.far_points_dropped() > 0)
         std::printf(
             "train: dropped %zu SfM point(s) more than %.4g from the cameras' centre (1000x their "

@@ -126,6 +126,7 @@ std::vector<MemberChange> every_member() {
         {"sky_pins_light", [](TrainConfig& c) { c.sky_pins_light = false; }},
         {"held_out_interval", [](TrainConfig& c) { c.held_out_interval = 250; }},
         {"lighting_init_radiance", [](TrainConfig& c) { c.lighting_init_radiance = 0.7; }},
+        {"exif_exposure", [](TrainConfig& c) { c.exif_exposure = true; }},
         {"use_sky_masks", [](TrainConfig& c) { c.use_sky_masks = false; }},
         {"lambda_sky_alpha", [](TrainConfig& c) { c.lambda_sky_alpha = 0.3; }},
         {"lambda_sky_colour", [](TrainConfig& c) { c.lambda_sky_colour = 0.7; }},
@@ -281,7 +282,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 65, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 66, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;

@@ -21,11 +21,11 @@ std::string exposure_note(const Dataset& scene) {
             ++known;
         }
     if (known == 0) return {};
-    char range[96];
-    std::snprintf(range, sizeof range, "EV100 %.2f to %.2f", lo, hi);
+    char range[128];
+    std::snprintf(range, sizeof range, "EV100 %.2f to %.2f (a spread of %.1f stops)", lo, hi, hi - lo);
     return "EXIF exposure of " + std::to_string(known) + " of " + photos(scene.views.size()) + ": " + range +
-           " (a spread of " + std::to_string(int(hi - lo + 0.5)) +
-           " stops; each photo's in the run's scene.json)";
+           "; each photo's in info --photos and the run's scene.json (train --set exif_exposure=true starts "
+           "each photo's light from it)";
 }
 
 }  // namespace

@@ -75,7 +75,11 @@ ShCoeffs<double> TrainedRun::learned_sh(int index) const {
     if (index < 0 || index >= lighting.num_images())
         throw Error(paths.lighting + ": no embedding " + std::to_string(index) + " (the run has " +
                     std::to_string(lighting.num_images()) + ")");
-    return lighting.env_sh(index).cast<double>();
+    ShCoeffs<double> sh = lighting.env_sh(index).cast<double>();
+    const double k = std::size_t(index) < exposures.size() ? exposures[std::size_t(index)] : 1.0;
+    if (k != 1.0)
+        for (auto& c : sh.c) c = k * c;
+    return sh;
 }
 
 TrainedRun load_trained_run(const std::string& dir) {
@@ -92,6 +96,7 @@ TrainedRun load_trained_run(const std::string& dir) {
     run.model = load_relightable_ply(run.paths.model);
     run.lighting = load_lighting_mlp(run.paths.lighting);
     run.image_names = load_appearance(run.paths.appearance);
+    run.exposures = load_appearance_exposures(run.paths.appearance);
     if (run.lighting.num_images() != int(run.image_names.size()))
         fail_in_file(run.paths.lighting, "has " + std::to_string(run.lighting.num_images()) +
                                              " embeddings but " + run.paths.appearance + " lists " +

@@ -21,6 +21,7 @@ struct TrainedRun {
     SurfelModel model;
     LightingMlp lighting;
     std::vector<std::string> image_names;  // appearance.json, in embedding order
+    std::vector<double> exposures;         // appearance.json's per photo (1 each unless exif_exposure)
     int downscale = 0;                     // config.json "downscale"; 0 if unknown
     bool sky_background = false;           // config.json "sky_background": trained with the sky drawn behind
     SkyResiduals sky_residuals;            // sky.lgsky when present (per-photo sky residuals)
@@ -39,7 +40,8 @@ struct TrainedRun {
 
     // Embedding index of the training photo called exactly `name`, or -1.
     int find_image(const std::string& name) const;
-    // The learned environment radiance SH of training photo `index` (lighting.env_sh(index)).
+    // The learned environment radiance SH of training photo `index`: exposures[index] x
+    // lighting.env_sh(index).
     ShCoeffs<double> learned_sh(int index) const;
 };
 

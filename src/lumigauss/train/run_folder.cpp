@@ -5,8 +5,9 @@
 
 namespace lumigauss {
 
-void save_run_model(const RunPaths& paths, const TrainState& state) {
-    save_run_model(paths, state.model, state.lighting, state.image_names, state.sky_residuals);
+void save_run_model(const RunPaths& paths, const TrainState& state, const std::vector<float>& exposures) {
+    save_run_model(paths, state.model, state.lighting, state.image_names, state.sky_residuals,
+                   std::vector<double>(exposures.begin(), exposures.end()));
 }
 
 std::string step_log_line(const StepReport& r, double elapsed_seconds, const HeldOutLog& held_out) {

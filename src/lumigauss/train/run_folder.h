@@ -10,8 +10,9 @@
 
 namespace lumigauss {
 
-// model.ply, lighting.lgmlp, appearance.json and (when trained) sky.lgsky of the state.
-void save_run_model(const RunPaths& paths, const TrainState& state);
+// model.ply, lighting.lgmlp, appearance.json (with the photos' exposures, Trainer::exposures) and (when
+// trained) sky.lgsky of the state.
+void save_run_model(const RunPaths& paths, const TrainState& state, const std::vector<float>& exposures);
 
 // The scores of a run's held-out photos for one snapshot of its model: means over the photos scored.
 struct HeldOutScore {

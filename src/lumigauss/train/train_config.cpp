@@ -93,6 +93,7 @@ constexpr std::array kFields = {
     LUMIGAUSS_FIELD(lr_sky_residual),
     LUMIGAUSS_FIELD(sky_pins_light),
     LUMIGAUSS_FIELD(lighting_init_radiance),
+    LUMIGAUSS_FIELD(exif_exposure),
     LUMIGAUSS_FIELD(use_sky_masks),
     LUMIGAUSS_FIELD(lambda_sky_alpha),
     LUMIGAUSS_FIELD(lambda_sky_colour),

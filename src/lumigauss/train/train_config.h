@@ -110,6 +110,11 @@ struct TrainConfig {
     // so that the sky and the shading see light from the first iteration (a sky below the radiance floor gets
     // no gradient).
     double lighting_init_radiance = 0.0;
+    // The photos' EXIF exposure (io/photo_exif.h) as the lighting's starting point: photo i's environment is
+    // 2^(mean EV - EV_i) x the network's output, a fixed factor the network then corrects as it needs
+    // (photos without EXIF: 1). The factors are saved with the run (appearance.json) and every use of a
+    // training photo's light includes them.
+    bool exif_exposure = false;
     bool use_sky_masks = true;  // false: train as if the scene had none (to measure what they bring)
     double lambda_sky_alpha = 0.0;
     double lambda_sky_colour = 0.0;

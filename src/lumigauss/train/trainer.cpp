@@ -128,9 +128,23 @@ std::vector<TrainView> load_train_views(const Dataset& dataset) {
         t.mask = dataset.load_mask(*v);
         t.sky = dataset.load_sky_mask(*v);
         t.coverage = dataset.load_coverage(*v);
+        t.ev100 = v->exif.ev100();
         out.push_back(std::move(t));
     }
     return out;
+}
+
+std::vector<float> exif_exposure_factors(const std::vector<TrainView>& views) {
+    double sum = 0;
+    int known = 0;
+    for (const TrainView& v : views)
+        if (v.ev100) sum += *v.ev100, ++known;
+    std::vector<float> factors(views.size(), 1.0f);
+    if (known == 0) return factors;
+    const double mean = sum / known;
+    for (std::size_t i = 0; i < views.size(); ++i)
+        if (views[i].ev100) factors[i] = float(std::exp2(mean - *views[i].ev100));
+    return factors;
 }
 
 Stage stage_of(const TrainConfig& config, std::int64_t iteration) {
@@ -215,6 +229,8 @@ Trainer::Trainer(std::vector<TrainView> views, const std::vector<Vec3f>& point_x
         state_.sky_residuals = SkyResiduals(int(views_.size()));
         state_.sky_residual_adam = sky_residual_optimizer(config, int(views_.size()));
     }
+    exposure_ =
+        config.exif_exposure ? exif_exposure_factors(views_) : std::vector<float>(views_.size(), 1.0f);
     prepare_view_masks();
 }
 
@@ -242,7 +258,17 @@ Trainer::Trainer(std::vector<TrainView> views, TrainState state)
                     std::to_string(state_.sky_residuals.num_images()) + " photos, the dataset has " +
                     std::to_string(views_.size()) + " training photos");
     up_ = views_up(views_).cast<float>();
+    exposure_ =
+        state_.config.exif_exposure ? exif_exposure_factors(views_) : std::vector<float>(views_.size(), 1.0f);
     prepare_view_masks();
+}
+
+ShCoeffs<float> Trainer::environment(int view) const {
+    ShCoeffs<float> env = state_.lighting.env_sh(view);
+    const float k = exposure_[std::size_t(view)];
+    if (k != 1.0f)
+        for (auto& c : env.c) c = k * c;
+    return env;
 }
 
 void Trainer::prepare_view_masks() {
@@ -344,8 +370,13 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
 
     auto t0 = Clock::now();
     const LightingForward<float> env_pass = state_.lighting.forward(report.view);
+    // The photo's environment: its exposure (1 unless exif_exposure) x the network's output.
+    const float exposure = exposure_[std::size_t(report.view)];
+    ShCoeffs<float> clean = env_pass.sh;
+    if (exposure != 1.0f)
+        for (auto& coeff : clean.c) coeff = exposure * coeff;
     // 3.5: one noise draw per iteration, shared by both renders; l_+ sees the clean SH.
-    ShCoeffs<float> env = env_pass.sh;
+    ShCoeffs<float> env = clean;
     Rng noise(hash_keys(c.seed, kEnvNoise, std::uint64_t(it)));
     for (int k = 0; k < kShCount; ++k)
         for (int ch = 0; ch < 3; ++ch) env.c[k][ch] += float(noise.normal() * c.env_noise_sigma);
@@ -464,7 +495,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
             sky_residual_grads_.add(report.view, g_res);
         }
     }
-    report.env = env_nonnegativity_loss(env_pass.sh, c.env_samples, c.seed, it, c.lambda_env, g_env);
+    report.env = env_nonnegativity_loss(clean, c.env_samples, c.seed, it, c.lambda_env, g_env);
     report.total += c.lambda_env * report.env;
     times_.losses += seconds_since(t0);
 
@@ -487,6 +518,8 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     model.accumulate_grads_from_activated(sg);
     const ShCoeffs<float> g_shading = shade_surfels_backward(model, env, mode, s.normals, sg.colors);
     for (int k = 0; k < kShCount; ++k) g_env.c[k] = g_env.c[k] + g_shading.c[k];
+    if (exposure != 1.0f)
+        for (auto& coeff : g_env.c) coeff = exposure * coeff;  // d env / d output = exposure
     lighting_grads_.backward(state_.lighting, env_pass, g_env);
     lighting_has_grad_ = true;
     // Densification statistics come from this render's screen-space gradient (2DGS: radii > 0 visible).

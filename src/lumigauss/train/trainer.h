@@ -39,7 +39,12 @@ struct TrainView {
     Image sky;
     // Where the photo holds the pixel's ray after undistortion (Dataset::load_coverage); empty = everywhere.
     Image coverage;
+    std::optional<double> ev100;  // the photo's EXIF exposure value (io/photo_exif.h), when it has one
 };
+
+// The lighting's fixed per-photo factors of config exif_exposure: 2^(mean EV100 - EV100_i) over the photos
+// that have one (the mean exposure is 1), 1 for the others; all 1 when none has one.
+std::vector<float> exif_exposure_factors(const std::vector<TrainView>& views);
 
 // The training photos of a dataset (its train split), in dataset (name) order; the position in this list
 // is the photo's row in the embedding table.
@@ -111,6 +116,10 @@ class Trainer {
     const TrainState& state() const { return state_; }
     TrainState& state() { return state_; }
     const std::vector<TrainView>& views() const { return views_; }
+    // Each training photo's environment is exposure(i) x the lighting network's output for it
+    // (exif_exposure_factors with config exif_exposure, else 1).
+    const std::vector<float>& exposures() const { return exposure_; }
+    ShCoeffs<float> environment(int view) const;
     // The ground seeds added to the SfM points at the start (config ground_seeds; none found or resumed:
     // found = false and no points).
     const GroundSeeds& ground() const { return ground_; }
@@ -126,6 +135,9 @@ class Trainer {
                physical = 0, optimizer = 0, densify = 0;
     };
     const PhaseTimes& phase_times() const { return times_; }
+    // The lighting network's gradient of the last step's loss (zero before the first step and in stage 2),
+    // for the finite-difference tests.
+    const LightingMlpGradients& lighting_gradients() const { return lighting_grads_; }
 
   private:
     struct Scratch;
@@ -142,6 +154,7 @@ class Trainer {
     std::vector<ViewMasks> masks_;  // per view: what the photometric, alpha and regulariser losses act on
     GroundSeeds ground_;
     Vec3f up_{0, 0, 1};  // the photos' up (camera_up_direction): the horizon of the sky, background_alpha
+    std::vector<float> exposure_;  // exposures()
     TrainState state_;
     std::unique_ptr<Scratch> scratch_;
     PhaseTimes times_;

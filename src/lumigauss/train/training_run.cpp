@@ -132,7 +132,7 @@ TrainingRun::~TrainingRun() = default;
 // that is still training, was stopped or was interrupted (each file is replaced atomically).
 void TrainingRun::save_checkpoint_and_snapshot() {
     save_checkpoint(paths_.checkpoint, trainer_->state());
-    save_run_model(paths_, trainer_->state());
+    save_run_model(paths_, trainer_->state(), trainer_->exposures());
 }
 
 double TrainingRun::elapsed_seconds() const {
@@ -189,7 +189,7 @@ TrainingOutcome TrainingRun::run(std::int64_t stop_after, const std::function<bo
         if (checkpoint_now || done)
             save_checkpoint_and_snapshot();
         else if (score_now)
-            save_run_model(paths_, trainer_->state());
+            save_run_model(paths_, trainer_->state(), trainer_->exposures());
         HeldOutLog held_out;
         if (score_now) held_out = score_snapshot();
         const bool log_now = r.iteration % config.log_interval == 0 || r.densify_ran || r.prune_ran || done ||
@@ -225,7 +225,7 @@ namespace {
 Image preview_image(const Trainer& trainer, int v) {
     const TrainView& view = trainer.views()[std::size_t(v)];
     const TrainState& st = trainer.state();
-    const ShCoeffs<float> env = st.lighting.env_sh(v);
+    const ShCoeffs<float> env = trainer.environment(v);
     RasterImages<float> img = render_with_environment(st.model, view.camera, env, ShadingMode::Both);
     if (st.config.sky_background) {
         const Sh4Coeffs<float> residual =
