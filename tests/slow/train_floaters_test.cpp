@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "fast/synth_test_util.h"
+#include "fast/trainer_test_util.h"
 #include "lumigauss/io/dataset.h"
 #include "lumigauss/io/image.h"
 #include "lumigauss/model/render_model.h"
@@ -25,24 +26,8 @@ namespace {
 
 using synth_test::TempDir;
 
-struct Scene {
-    std::string root;
-    Dataset data;
-    std::vector<TrainView> views;
-};
-
-const Scene& tiny_plaza() {
-    static TempDir dir("train_floaters");
-    static const Scene scene = [] {
-        synth::generate_synthetic_scene(synth_test::tiny_options(dir.str()));
-        Scene s;
-        s.root = dir.str();
-        s.data = load_dataset(s.root, DatasetOptions{});
-        s.views = load_train_views(s.data);
-        return s;
-    }();
-    return scene;
-}
+using trainer_test::tiny_scene;
+using trainer_test::TinyScene;
 
 // Surfels within `near` of the camera whose reachable pixels reach more than a tenth of the image height
 // above the camera's horizon (the image row of the world's horizontal directions, +z up).
@@ -101,7 +86,7 @@ TEST(TrainFloaters, InitialSurfelsNearTheCameraLieInTheGround) {
 }
 
 // Share of the test views' sky pixels (gt/mask = 0) where the trained model's alpha exceeds 0.5.
-double sky_coverage(const Scene& s, const GaussianModel& model) {
+double sky_coverage(const TinyScene& s, const GaussianModel& model) {
     std::size_t sky = 0, covered = 0;
     for (const View* v : s.data.split(Split::Test)) {
         std::filesystem::path mask_path = std::filesystem::path(s.root) / "gt" / "mask" / v->name;
@@ -118,7 +103,7 @@ double sky_coverage(const Scene& s, const GaussianModel& model) {
 }
 
 TEST(TrainFloaters, TheSkyIsDrawnBehindTheSurfelsNotByThem) {
-    const Scene& s = tiny_plaza();
+    const TinyScene& s = tiny_scene();
     const auto train = [&](const char* preset) {
         TrainConfig c = train_preset(preset);
         c.iterations = 400;  // stage 1 only: the sky question is settled there
@@ -146,7 +131,7 @@ TEST(TrainFloaters, ObjectMasksKeepTheOutsideEmpty) {
     o.object_masks = true;
     o.transient_fraction = 0;
     synth::generate_synthetic_scene(o);
-    Scene s;
+    TinyScene s;
     s.root = dir.str();
     s.data = load_dataset(s.root, DatasetOptions{});
     s.views = load_train_views(s.data);
