@@ -13,6 +13,7 @@
 #include "lumigauss/io/image_orientation.h"
 #include "lumigauss/io/photo_exif.h"
 #include "lumigauss/model/scene_record.h"
+#include "support/run_cli.h"
 
 namespace lumigauss {
 namespace {
@@ -269,6 +270,31 @@ TEST(PhotoExifScene, PhotosTurnUprightOnlyWhenTheirCameraSaysSo) {
     write_png(tmp / "images/img_0.png", test::test_image(6, 7, 3));
     add_png_exif(tmp / "images/img_0.png", camera_block(true, 6));
     expect_error([&] { load_dataset(tmp.path().string()); }, {"img_0.png", "6x7", "8x6"});
+}
+
+// `lumigauss info --photos`: one line per photo with what its EXIF said and what was done with it.
+TEST(CliInfoExif, PhotosListsEachPhotosExif) {
+    TempDir tmp;
+    const fs::path scene = tmp.path() / "scene";
+    test::write_scene(scene, test::small_model(3, 8, 6));
+    write_png((scene / "images/img_0.png").string(), upright_image(test::test_image(8, 6, 3), 8));
+    add_png_exif((scene / "images/img_0.png").string(), camera_block(true, 6));
+    add_png_exif((scene / "images/img_1.png").string(), camera_block(false, 6));
+    const testing::CommandResult r =
+        testing::run_lumigauss("info " + testing::shell_quoted(scene.string()) + " --photos", tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("exif:          1 photo turned upright"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("EV100 11.94 to 11.94"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("img_0.png  test  8x6  6 (turned upright)  1/250 s  f/5.6  200  11.94"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("img_1.png  train  8x6  6 (as stored)  1/250 s  f/5.6  200  11.94"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("img_2.png  train  8x6  1  -  -  -  -"), std::string::npos) << r.output;
+    const testing::CommandResult plain =
+        testing::run_lumigauss("info " + testing::shell_quoted(scene.string()), tmp);
+    EXPECT_EQ(plain.output.find("img_0.png"), std::string::npos) << "one line per photo only with --photos";
 }
 
 }  // namespace
