@@ -44,6 +44,18 @@ Mat3d axis_panorama_frame(Vec3d axis) {
     return rotation_about_axis(Vec3d{0, 1, 0}, -half_pi);
 }
 
+// sum x x^T over the cameras' x axes (row 0 of each world-to-camera rotation): the up is the direction it
+// is smallest along.
+Mat3d x_axis_scatter(const std::vector<Mat3d>& world_to_camera) {
+    Mat3d scatter{};
+    for (const Mat3d& r : world_to_camera) {
+        const Vec3d x = r.row(0);
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) scatter(i, j) += x[i] * x[j];
+    }
+    return scatter;
+}
+
 }  // namespace
 
 Vec3d parse_up_axis(const std::string& text) {
@@ -65,13 +77,8 @@ Vec3d parse_up_axis(const std::string& text) {
 
 Vec3d camera_up_direction(const std::vector<Mat3d>& world_to_camera) {
     Vec3d mean{};
-    Mat3d scatter{};
-    for (const Mat3d& r : world_to_camera) {
-        mean += -r.row(1);
-        const Vec3d x = r.row(0);
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) scatter(i, j) += x[i] * x[j];
-    }
+    for (const Mat3d& r : world_to_camera) mean += -r.row(1);
+    const Mat3d scatter = x_axis_scatter(world_to_camera);
     const double n = double(world_to_camera.size());
     if (!(length(mean) > 1e-9 * n)) return {};
     const SymmetricEigen e = symmetric_eigen(scatter);
@@ -91,12 +98,7 @@ Vec3d scene_up_direction(const std::vector<Mat3d>& world_to_camera, const std::v
     if (!ground.found) return cameras_up;
     // sum x x^T + w (I - n n^T): its smallest eigenvector.
     const double w = kGroundUpWeight * double(world_to_camera.size());
-    Mat3d m{};
-    for (const Mat3d& r : world_to_camera) {
-        const Vec3d x = r.row(0);
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) m(i, j) += x[i] * x[j];
-    }
+    Mat3d m = x_axis_scatter(world_to_camera);
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j)
             m(i, j) += w * ((i == j ? 1.0 : 0.0) - ground.normal[i] * ground.normal[j]);

@@ -147,6 +147,21 @@ std::vector<float> exif_exposure_factors(const std::vector<TrainView>& views) {
     return factors;
 }
 
+namespace {
+
+// Trainer::exposures of a run: the EXIF factors with config exif_exposure, else 1 for every photo.
+std::vector<float> run_exposures(const TrainConfig& config, const std::vector<TrainView>& views) {
+    return config.exif_exposure ? exif_exposure_factors(views) : std::vector<float>(views.size(), 1.0f);
+}
+
+// `sh` times a photo's exposure (1 changes nothing: x * 1 is exact).
+ShCoeffs<float> times_exposure(ShCoeffs<float> sh, float exposure) {
+    for (auto& c : sh.c) c = exposure * c;
+    return sh;
+}
+
+}  // namespace
+
 Stage stage_of(const TrainConfig& config, std::int64_t iteration) {
     if (iteration < config.warmup) return Stage::Unshadowed;
     if (iteration <= config.start_shadowed) return Stage::TransferFitting;
@@ -229,8 +244,7 @@ Trainer::Trainer(std::vector<TrainView> views, const std::vector<Vec3f>& point_x
         state_.sky_residuals = SkyResiduals(int(views_.size()));
         state_.sky_residual_adam = sky_residual_optimizer(config, int(views_.size()));
     }
-    exposure_ =
-        config.exif_exposure ? exif_exposure_factors(views_) : std::vector<float>(views_.size(), 1.0f);
+    exposure_ = run_exposures(config, views_);
     prepare_view_masks();
 }
 
@@ -258,17 +272,12 @@ Trainer::Trainer(std::vector<TrainView> views, TrainState state)
                     std::to_string(state_.sky_residuals.num_images()) + " photos, the dataset has " +
                     std::to_string(views_.size()) + " training photos");
     up_ = views_up(views_).cast<float>();
-    exposure_ =
-        state_.config.exif_exposure ? exif_exposure_factors(views_) : std::vector<float>(views_.size(), 1.0f);
+    exposure_ = run_exposures(state_.config, views_);
     prepare_view_masks();
 }
 
 ShCoeffs<float> Trainer::environment(int view) const {
-    ShCoeffs<float> env = state_.lighting.env_sh(view);
-    const float k = exposure_[std::size_t(view)];
-    if (k != 1.0f)
-        for (auto& c : env.c) c = k * c;
-    return env;
+    return times_exposure(state_.lighting.env_sh(view), exposure_[std::size_t(view)]);
 }
 
 void Trainer::prepare_view_masks() {
@@ -372,9 +381,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     const LightingForward<float> env_pass = state_.lighting.forward(report.view);
     // The photo's environment: its exposure (1 unless exif_exposure) x the network's output.
     const float exposure = exposure_[std::size_t(report.view)];
-    ShCoeffs<float> clean = env_pass.sh;
-    if (exposure != 1.0f)
-        for (auto& coeff : clean.c) coeff = exposure * coeff;
+    const ShCoeffs<float> clean = times_exposure(env_pass.sh, exposure);
     // 3.5: one noise draw per iteration, shared by both renders; l_+ sees the clean SH.
     ShCoeffs<float> env = clean;
     Rng noise(hash_keys(c.seed, kEnvNoise, std::uint64_t(it)));
@@ -518,8 +525,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     model.accumulate_grads_from_activated(sg);
     const ShCoeffs<float> g_shading = shade_surfels_backward(model, env, mode, s.normals, sg.colors);
     for (int k = 0; k < kShCount; ++k) g_env.c[k] = g_env.c[k] + g_shading.c[k];
-    if (exposure != 1.0f)
-        for (auto& coeff : g_env.c) coeff = exposure * coeff;  // d env / d output = exposure
+    g_env = times_exposure(g_env, exposure);  // d env / d output = exposure
     lighting_grads_.backward(state_.lighting, env_pass, g_env);
     lighting_has_grad_ = true;
     // Densification statistics come from this render's screen-space gradient (2DGS: radii > 0 visible).
