@@ -151,7 +151,7 @@ void run_export(const ExportOptions& o) {
     TrainedRun run = load_run_or_ply(source);
     if (region.any()) crop_and_recentre(run, region, o.quiet);
     // auto: the up of the training photos the run recorded; +z for a bare PLY.
-    const Vec3d up = o.up == "auto" ? run.scene_up.value_or(Vec3d{0, 0, 1}) : parse_up_axis(o.up);
+    const Vec3d up = o.up == "auto" ? run.scene_up().value_or(Vec3d{0, 0, 1}) : parse_up_axis(o.up);
     if (baked) {
         PanoramaOptions popt;
         popt.frame = panorama_frame_for_up(up);

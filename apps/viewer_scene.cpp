@@ -43,7 +43,7 @@ std::vector<Camera> known_cameras(const ViewerSceneOptions& o) {
 Vec3d resolve_up(const ViewerSceneOptions& o, const std::vector<Camera>& cams, const TrainedRun& run) {
     if (o.up != "auto") return parse_up_axis(o.up);
     if (!cams.empty()) return estimate_up_axis(cams);
-    return run.scene_up.value_or(Vec3d{0, 0, 1});
+    return run.scene_up().value_or(Vec3d{0, 0, 1});
 }
 
 }  // namespace

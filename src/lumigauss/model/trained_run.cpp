@@ -82,6 +82,11 @@ ShCoeffs<double> TrainedRun::learned_sh(int index) const {
     return sh;
 }
 
+std::optional<Vec3d> TrainedRun::scene_up() const {
+    if (!photos_up) return std::nullopt;
+    return scene_up_direction(photo_rotations, photo_centres, model.centres());
+}
+
 TrainedRun load_trained_run(const std::string& dir) {
     namespace fs = std::filesystem;
     TrainedRun run;
@@ -111,8 +116,7 @@ TrainedRun load_trained_run(const std::string& dir) {
     }
     const RecordedTrainingCameras cameras = recorded_training_cameras(dir);
     run.photos_up = photos_up_of(cameras);
-    if (run.photos_up)
-        run.scene_up = scene_up_direction(cameras.rotations, cameras.centres, run.model.centres());
+    run.photo_rotations = cameras.rotations;
     run.photo_centres = cameras.centres;
     if (fs::exists(run.paths.config)) {
         const nlohmann::json c = nlohmann::json::parse(read_text_file(run.paths.config), nullptr, false);

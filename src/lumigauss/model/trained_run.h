@@ -28,11 +28,10 @@ struct TrainedRun {
     // The world's up as the training photos that scene.json records give it (camera_up_direction); none
     // without the record (a bare PLY, a run of an older version).
     std::optional<Vec3d> photos_up;
-    // The up for --up auto: photos_up refined by the ground under those cameras in the surfels
-    // (scene_up_direction, cameras/up_axis.h); none without photos_up. photos_up stays the trained sky's.
-    std::optional<Vec3d> scene_up;
-    // The centres of the cameras of those training photos (empty without the record): which side of each
-    // surfel the photos saw, for exports that hold one colour per surfel.
+    // The world-to-camera rotations and centres of the cameras of those training photos (empty without the
+    // record). The centres say which side of each surfel the photos saw, for exports that hold one colour
+    // per surfel.
+    std::vector<Mat3d> photo_rotations;
     std::vector<Vec3d> photo_centres;
     // Where that sky ends below the horizon: config.json sky_horizon_start/fade, about photos_up (no horizon
     // without it, as the run was trained then).
@@ -43,6 +42,11 @@ struct TrainedRun {
     // The learned environment radiance SH of training photo `index`: exposures[index] x
     // lighting.env_sh(index).
     ShCoeffs<double> learned_sh(int index) const;
+    // The up for --up auto: photos_up refined by the ground under those cameras in the surfels
+    // (scene_up_direction, cameras/up_axis.h); none without photos_up. photos_up stays the trained sky's.
+    // Computed on each call (a RANSAC over up to 20000 surfel centres, 10-30 ms), so that loading a run
+    // costs nothing for the commands that never ask.
+    std::optional<Vec3d> scene_up() const;
 };
 
 // Loads model.ply, lighting.lgmlp, appearance.json (and config.json and scene.json if present) of a run
