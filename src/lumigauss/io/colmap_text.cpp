@@ -80,16 +80,22 @@ class Lines {
     std::optional<std::size_t> declared_;
 };
 
+bool is_blank(char c) {
+    return c == ' ' || c == '\t';
+}
+
+// The blank-separated tokens of a line. A plain loop: string_view::find_first_of with a set of two took
+// about 70 instructions per byte, half of reading a 7 MB images.txt.
 std::vector<std::string_view> split(std::string_view line) {
     std::vector<std::string_view> tokens;
-    std::size_t pos = 0;
+    const char* p = line.data();
+    const char* const end = p + line.size();
     while (true) {
-        const std::size_t start = line.find_first_not_of(" \t", pos);
-        if (start == std::string_view::npos) break;
-        std::size_t end = line.find_first_of(" \t", start);
-        if (end == std::string_view::npos) end = line.size();
-        tokens.push_back(line.substr(start, end - start));
-        pos = end;
+        while (p != end && is_blank(*p)) ++p;
+        if (p == end) break;
+        const char* const start = p;
+        while (p != end && !is_blank(*p)) ++p;
+        tokens.emplace_back(start, std::size_t(p - start));
     }
     return tokens;
 }
