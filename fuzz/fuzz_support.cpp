@@ -15,10 +15,19 @@ namespace {
 
 constexpr std::string_view kSeparator = "\n--lumigauss-fuzz-part--\n";
 
+// Where the parsers' input files are written, once per execution: a memory file system when there is one.
+// On a disk-backed /tmp the write-truncate-reopen of every input cost two thirds of a small parser's time
+// (split_file: 2.7k executions/s in /tmp, 8.3k in /dev/shm, libFuzzer, 20 s each).
+fs::path scratch_base() {
+    std::error_code ec;
+    if (fs::is_directory("/dev/shm", ec) && ::access("/dev/shm", W_OK) == 0) return "/dev/shm";
+    return fs::temp_directory_path();
+}
+
 struct ScratchFolder {
     fs::path path;
     ScratchFolder() {
-        path = fs::temp_directory_path() / ("lumigauss_fuzz_" + std::to_string(::getpid()));
+        path = scratch_base() / ("lumigauss_fuzz_" + std::to_string(::getpid()));
         fs::create_directories(path);
     }
     ~ScratchFolder() {
