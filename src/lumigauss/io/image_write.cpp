@@ -49,6 +49,12 @@ bool encode_png(std::FILE* f, const Image& image, int bits, png_bytep* rows, Png
     png_set_IHDR(png, info, png_uint_32(image.width), png_uint_32(image.height), bits,
                  kColorTypes[image.channels - 1], PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                  PNG_FILTER_TYPE_DEFAULT);
+    // Fast deflate and one filter: renders, orbits, eval sheets and training previews write many images, and
+    // libpng's defaults (level 6, every filter tried per row) took longer than rendering them. Measured on a
+    // render's ten 320 x 240 maps and on twelve eval sheets: 4.3x and 3.7x faster, 19 % and 14 % more bytes
+    // (OpenCV's imwrite also defaults to level 1).
+    png_set_compression_level(png, 1);
+    png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_PAETH);
     png_write_info(png, info);
     png_write_image(png, rows);
     png_write_end(png, nullptr);
