@@ -90,8 +90,9 @@ void run_gt_env(const EvalOptions& o) {
             std::printf("  normals: mean %.2f deg, median %.2f deg\n", result.mean_normal.mean_deg,
                         result.mean_normal.median_deg);
         if (result.has_sky)
-            std::printf("  sky pixels (gt/mask = 0) with alpha > 0.5: %.2f %%\n",
-                        100 * result.sky_alpha_fraction);
+            std::printf(
+                "  sky pixels (gt/mask = 0) with alpha > 0.5: %.2f %%; mean alpha over the sky %.4f\n",
+                100 * result.sky_alpha_fraction, result.sky_mean_alpha);
         std::printf(
             "  evaluated pixels left empty (alpha <= 0.5): %.2f %%; shadowed PSNR over the others %.2f\n",
             100 * result.empty_fraction, result.mean_covered_shadowed_psnr);
@@ -107,14 +108,15 @@ void run_gt_env(const EvalOptions& o) {
     std::printf(
         "eval-summary: shadowed_psnr=%.4f shadowed_ssim=%.4f unshadowed_psnr=%.4f unshadowed_ssim=%.4f "
         "albedo_psnr=%.4f normal_mean_deg=%.3f normal_median_deg=%.3f render_ms=%.2f sky_alpha=%.4f "
-        "light_residual=%.4f empty=%.4f covered_psnr=%.4f scaled_psnr=%.4f\n",
+        "light_residual=%.4f empty=%.4f covered_psnr=%.4f scaled_psnr=%.4f sky_mean_alpha=%.4f\n",
         result.mean_shadowed.psnr, result.mean_shadowed.ssim, result.mean_unshadowed.psnr,
         result.mean_unshadowed.ssim, result.has_albedo ? result.mean_albedo.psnr : nan,
         result.has_normal ? result.mean_normal.mean_deg : nan,
         result.has_normal ? result.mean_normal.median_deg : nan, result.median_render_ms,
         result.has_sky ? result.sky_alpha_fraction : nan, result.light.relative_residual,
         result.empty_fraction, result.mean_covered_shadowed_psnr,
-        result.image_scaled ? result.mean_image_scaled_shadowed.psnr : nan);
+        result.image_scaled ? result.mean_image_scaled_shadowed.psnr : nan,
+        result.has_sky ? result.sky_mean_alpha : nan);
     std::printf("eval: wrote %s/metrics.json and %s/report.md (%.1f s)\n", o.out.c_str(), o.out.c_str(), s);
 }
 

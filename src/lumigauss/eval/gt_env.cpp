@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <limits>
 
+#include "lumigauss/eval/sky_coverage.h"
 #include "lumigauss/relight/relit_render.h"
 #include "lumigauss/relight/relit_sky.h"
 #include "lumigauss/render/raster_maps.h"
@@ -89,15 +90,12 @@ struct Evaluation {
     bool every_gt_mask = true;                // every scored view had a gt/mask
 };
 
-// Sky pixels (gt/mask exactly 0) of a view and the share of them the render covers (alpha > 0.5).
+// Sky pixels (gt/mask exactly 0) of a view: the share the render covers (alpha > 0.5) and its mean alpha.
 void score_sky(const Image& coverage, const RasterImages<float>& relit, GtEnvImageResult& r) {
-    std::size_t covered = 0;
-    for (std::size_t q = 0; q < coverage.pixels.size(); ++q) {
-        if (coverage.pixels[q] != 0.0f) continue;
-        ++r.sky_pixels;
-        covered += relit.alpha[q] > 0.5f ? 1 : 0;
-    }
-    r.sky_alpha_fraction = r.sky_pixels > 0 ? double(covered) / double(r.sky_pixels) : 0.0;
+    const SkyCoverage sky = sky_coverage(coverage, relit.alpha);
+    r.sky_pixels = sky.pixels;
+    r.sky_alpha_fraction = sky.covered;
+    r.sky_mean_alpha = sky.mean_alpha;
 }
 
 // The evaluated pixels the render leaves empty, and the shadowed PSNR over the others (header, step 6).
@@ -269,7 +267,7 @@ void summarize_views(GtEnvResult& result) {
         sum.psnr += m.psnr / n, sum.mse += m.mse / n, sum.mae += m.mae / n;
     };
     std::size_t sky_pixels = 0, evaluated = 0, covered_images = 0;
-    double sky_covered = 0, empty = 0;
+    double sky_covered = 0, sky_alpha = 0, empty = 0;
     std::vector<double> render_ms;
     for (const GtEnvImageResult& r : result.images) {
         add_metrics(result.mean_shadowed, r.shadowed);
@@ -278,6 +276,7 @@ void summarize_views(GtEnvResult& result) {
         if (result.has_albedo)
             add_albedo(result.mean_albedo, r.albedo), add_albedo(result.mean_albedo_gamma, r.albedo_gamma);
         sky_pixels += r.sky_pixels, sky_covered += r.sky_alpha_fraction * double(r.sky_pixels);
+        sky_alpha += r.sky_mean_alpha * double(r.sky_pixels);
         evaluated += r.mask_pixels, empty += r.empty_fraction * double(r.mask_pixels);
         if (!std::isnan(r.covered_shadowed_psnr))
             result.mean_covered_shadowed_psnr += r.covered_shadowed_psnr, ++covered_images;
@@ -289,6 +288,7 @@ void summarize_views(GtEnvResult& result) {
                                             : std::numeric_limits<double>::quiet_NaN();
     result.has_sky = sky_pixels > 0;
     result.sky_alpha_fraction = result.has_sky ? sky_covered / double(sky_pixels) : 0.0;
+    result.sky_mean_alpha = result.has_sky ? sky_alpha / double(sky_pixels) : 0.0;
     if (!render_ms.empty()) {
         std::sort(render_ms.begin(), render_ms.end());
         result.median_render_ms = render_ms[render_ms.size() / 2];

@@ -69,10 +69,12 @@ struct GtEnvImageResult {
     double exposure = 1.0;
     std::size_t mask_pixels = 0;
     double render_ms = 0;  // wall time of the one 6-channel render (shadowed + unshadowed + maps)
-    // Sky pixels (gt/mask exactly 0) and the share of them where the render's alpha exceeds 0.5: surfels
-    // painting the sky seen from a new viewpoint. 0 pixels when the scene has no gt/mask.
+    // Sky pixels (gt/mask exactly 0), the share of them where the render's alpha exceeds 0.5 (surfels
+    // painting the sky seen from a new viewpoint) and their mean alpha (a faint veil in front of the camera);
+    // eval/sky_coverage.h. 0 pixels when the scene has no gt/mask.
     std::size_t sky_pixels = 0;
     double sky_alpha_fraction = 0;
+    double sky_mean_alpha = 0;
     // Evaluated pixels the model leaves empty (alpha <= 0.5): geometry no training photo pinned down, drawn
     // as background. The shadowed PSNR over the other evaluated pixels separates that from the shading error
     // (NaN when the model covers none of them).
@@ -103,6 +105,7 @@ struct GtEnvResult {
     double median_render_ms = 0;
     bool has_sky = false;                   // some scored image had sky pixels
     double sky_alpha_fraction = 0;          // over every sky pixel of every scored image
+    double sky_mean_alpha = 0;              // the mean alpha over those pixels
     double empty_fraction = 0;              // over every evaluated pixel of every scored image
     double mean_covered_shadowed_psnr = 0;  // mean over the images that have covered pixels
     std::array<double, 3> albedo_scale{1, 1, 1}, albedo_gamma_scale{1, 1, 1};

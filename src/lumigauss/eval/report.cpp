@@ -196,7 +196,9 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
             e["albedo"] = albedo_json(im.albedo), e["albedo_gamma"] = albedo_json(im.albedo_gamma);
         if (im.has_normal) e["normal"] = normal_json(im.normal);
         if (im.sky_pixels > 0)
-            e["sky"] = {{"pixels", im.sky_pixels}, {"alpha_above_half", number(im.sky_alpha_fraction)}};
+            e["sky"] = {{"pixels", im.sky_pixels},
+                        {"alpha_above_half", number(im.sky_alpha_fraction)},
+                        {"mean_alpha", number(im.sky_mean_alpha)}};
         e["empty"] = {{"fraction", number(im.empty_fraction)},
                       {"shadowed_psnr_covered", number(im.covered_shadowed_psnr)}};
         if (r.image_scaled) e["shadowed_image_scaled"] = image_metrics_json(im.image_scaled_shadowed);
@@ -214,6 +216,12 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
             {"value", number(r.sky_alpha_fraction)},
             {"meaning",
              "share of all sky pixels (gt/mask = 0) of the scored images where the render's alpha > 0.5"}};
+    if (r.has_sky)
+        mean["sky_mean_alpha"] = {{"value", number(r.sky_mean_alpha)},
+                                  {"meaning",
+                                   "mean alpha of the render over all sky pixels (gt/mask = 0) of the scored "
+                                   "images: faint surfels in "
+                                   "front of the camera that never reach 0.5"}};
     mean["empty"] = {
         {"fraction", number(r.empty_fraction)},
         {"shadowed_psnr_covered", number(r.mean_covered_shadowed_psnr)},
@@ -314,7 +322,8 @@ std::string gt_env_report_markdown(const GtEnvResult& r, const ReportSources& sr
          " %; shadowed PSNR over the covered ones " + fmt("%.2f", r.mean_covered_shadowed_psnr) + " dB.\n";
     if (r.has_sky)
         s += "\nSky pixels (`gt/mask` = 0) covered by surfels (alpha > 0.5): " +
-             fmt("%.2f", 100 * r.sky_alpha_fraction) + " %.\n";
+             fmt("%.2f", 100 * r.sky_alpha_fraction) + " %; mean alpha over the sky " +
+             fmt("%.4f", r.sky_mean_alpha) + ".\n";
     s += "\n## Per image\n\n| image | condition | exposure | PSNR sh. | SSIM sh. | PSNR unsh. | SSIM unsh. | "
          "albedo PSNR | normal mean / median |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
     for (const GtEnvImageResult& im : r.images)
