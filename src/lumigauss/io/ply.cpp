@@ -198,21 +198,19 @@ void read_element_binary(std::istream& in, const PlyElement& e, bool swap, PlyVe
     // Fixed-size records, read a block of them at a time.
     const std::size_t record = record_size(e);
     const std::size_t block_records = std::max<std::size_t>(1, (std::size_t(1) << 16) / record);
-    std::vector<std::size_t> offsets;
-    for (std::size_t k = 0, off = 0; k < e.properties.size();
-         off += std::size_t(scalar_size(e.properties[k].type)), ++k)
-        offsets.push_back(off);
     std::vector<unsigned char> block(std::min(block_records, e.count) * record);
     for (std::size_t first = 0; first < e.count; first += block_records) {
         const std::size_t n = std::min(block_records, e.count - first);
         in.read(reinterpret_cast<char*>(block.data()), std::streamsize(n * record));
         if (!in) truncated_at(first + std::size_t(in.gcount()) / record);
         if (!table) continue;
+        std::size_t offset = 0;  // of property k in a record
         for (std::size_t k = 0; k < e.properties.size(); ++k) {
             float* column = table->columns[k].data() + first;
             const PlyScalar type = e.properties[k].type;
-            const unsigned char* value = block.data() + offsets[k];
+            const unsigned char* value = block.data() + offset;
             for (std::size_t i = 0; i < n; ++i, value += record) column[i] = float(decode(type, value, swap));
+            offset += std::size_t(scalar_size(type));
         }
     }
 }
