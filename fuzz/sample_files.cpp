@@ -65,7 +65,11 @@ void parse_colmap_parts(Bytes input, const std::string& extension) {
     make_folder(dir);
     const std::vector<std::string> files = colmap_files(extension), parts = split_parts(input, files.size());
     for (std::size_t i = 0; i < files.size(); ++i) write_file(dir + "/" + files[i], parts[i]);
-    refuse_cleanly([&] { (void)(extension == ".txt" ? read_colmap_text(dir) : read_colmap_binary(dir)); });
+    // Both ways a model is read: whole (tools that write it back), and poses and points alone (load_dataset).
+    for (const ColmapContent content : {ColmapContent::Everything, ColmapContent::PosesAndPoints})
+        refuse_cleanly([&] {
+            (void)(extension == ".txt" ? read_colmap_text(dir, content) : read_colmap_binary(dir, content));
+        });
 }
 
 }  // namespace lumigauss::fuzz

@@ -101,6 +101,41 @@ TEST(ColmapIo, BinaryRoundTripIsExact) {
     EXPECT_FALSE(find_colmap_format(tmp.path().string()).has_value());
 }
 
+// Loading a scene reads poses and points only: the same model without observations, tracks and errors, in
+// both forms, and a fault in the parts it skips does not stop it (they are not read).
+TEST(ColmapIo, PosesAndPointsSkipObservationsAndTracks) {
+    TempDir tmp;
+    ColmapModel expected = varied_model();
+    write_colmap_text(tmp / "t", expected);
+    write_colmap_binary(tmp / "b", expected);
+    for (ColmapImage& im : expected.images) im.observations.clear();
+    expected.point_error.clear();
+    expected.point_tracks.clear();
+    expect_same_model(read_colmap_text(tmp / "t", ColmapContent::PosesAndPoints), expected);
+    expect_same_model(read_colmap_binary(tmp / "b", ColmapContent::PosesAndPoints), expected);
+    expect_same_model(read_colmap(tmp / "b", ColmapContent::PosesAndPoints), expected);
+
+    // An odd token in a POINTS2D line and in a track: read in full they fail, poses and points still read.
+    std::string images = test::read_text(tmp / "t/images.txt");
+    images.replace(images.find("0.123456789"), 11, "x.123456789");
+    test::write_text(tmp / "t/images.txt", images);
+    expect_error([&] { read_colmap_text(tmp / "t"); }, {"images.txt", "x.123456789"});
+    EXPECT_EQ(read_colmap_text(tmp / "t", ColmapContent::PosesAndPoints).images.size(),
+              expected.images.size());
+    std::string points = test::read_text(tmp / "t/points3D.txt");
+    points.insert(points.find('\n', points.find("\n1 ")), " 7");  // an odd track
+    test::write_text(tmp / "t/points3D.txt", points);
+    EXPECT_EQ(read_colmap_text(tmp / "t", ColmapContent::PosesAndPoints).point_xyz.size(),
+              expected.point_xyz.size());
+
+    // A binary file cut inside the skipped part is still caught: its lengths are checked before skipping.
+    std::string bin = test::read_text(tmp / "b/images.bin");
+    bin.resize(bin.size() - 10);
+    test::write_text(tmp / "b/images.bin", bin);
+    expect_error([&] { read_colmap_binary(tmp / "b", ColmapContent::PosesAndPoints); },
+                 {"images.bin", "truncated"});
+}
+
 TEST(ColmapIo, ReadsPlazaAndConvertsToBinary) {
     const std::string plaza = test::plaza_dir();
     if (plaza.empty()) GTEST_SKIP() << "shared data/plaza_mini not present";

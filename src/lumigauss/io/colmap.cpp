@@ -4,7 +4,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <unordered_map>
 
 #include "lumigauss/io/colmap_detail.h"
@@ -69,11 +68,12 @@ std::optional<ColmapFormat> find_colmap_format(const std::string& dir) {
     return std::nullopt;
 }
 
-ColmapModel read_colmap(const std::string& dir) {
+ColmapModel read_colmap(const std::string& dir, ColmapContent content) {
     const auto format = find_colmap_format(dir);
     if (!format)
         fail_in_file(dir, "no COLMAP model here (need cameras, images and points3D, all .bin or all .txt)");
-    return *format == ColmapFormat::Binary ? read_colmap_binary(dir) : read_colmap_text(dir);
+    return *format == ColmapFormat::Binary ? read_colmap_binary(dir, content)
+                                           : read_colmap_text(dir, content);
 }
 
 namespace colmap_detail {
@@ -85,10 +85,15 @@ std::string join(const std::string& dir, const char* file) {
 std::string read_whole_file(const std::string& path) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) fail_in_file(path, "file not found");
-    std::ifstream in(path, std::ios::binary);
+    // One read of the known size: a character iterator took 14 instructions per byte, a tenth of a render's
+    // start on plaza (11 MB of text).
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
     if (!in) fail_in_file(path, "cannot open the file");
-    std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) fail_in_file(path, "read error");
+    const std::streamoff size = in.tellg();
+    if (size < 0) fail_in_file(path, "cannot tell the file's size");
+    std::string content(std::size_t(size), '\0');
+    in.seekg(0);
+    if (size > 0 && !in.read(content.data(), size)) fail_in_file(path, "read error");
     return content;
 }
 

@@ -72,13 +72,19 @@ enum class ColmapFormat { Binary, Text };
 // (COLMAP's own preference), else the text form, else nullopt.
 std::optional<ColmapFormat> find_colmap_format(const std::string& dir);
 
+// What to read of a model. The images' 2D observations and the points' tracks and errors are most of a
+// large model's bytes, and loading a scene to train, render or evaluate uses none of them: PosesAndPoints
+// leaves them empty (and does not check them: a file whose only fault is in them reads).
+enum class ColmapContent { Everything, PosesAndPoints };
+
 // Reads `dir`/{cameras,images,points3D}.{bin,txt}. Throws Error naming the file and the record or line for
 // a missing or truncated file, a malformed line, an unknown camera model, a parameter count that does not
 // match the model, a non-finite pose, or an image whose camera id is not in cameras. An observation whose
 // POINT3D_ID is not in points3D (a model edited by hand) reads as belonging to no point.
-ColmapModel read_colmap_binary(const std::string& dir);
-ColmapModel read_colmap_text(const std::string& dir);
-ColmapModel read_colmap(const std::string& dir);  // by find_colmap_format; Error naming `dir` if neither
+ColmapModel read_colmap_binary(const std::string& dir, ColmapContent content = ColmapContent::Everything);
+ColmapModel read_colmap_text(const std::string& dir, ColmapContent content = ColmapContent::Everything);
+// By find_colmap_format; Error naming `dir` if neither.
+ColmapModel read_colmap(const std::string& dir, ColmapContent content = ColmapContent::Everything);
 
 // Writes the three files into `dir` (created if missing), each atomically. Numbers are written in the
 // shortest form that reads back to the same value, so reading back gives identical records; colours are

@@ -36,6 +36,12 @@ class Reader {
         return value;
     }
 
+    // Passes over `bytes` that the caller does not need (checked like a read).
+    void skip(std::uint64_t bytes) {
+        need(bytes);
+        pos_ += std::size_t(bytes);
+    }
+
     std::string get_cstring() {
         const std::size_t end = data_.find('\0', pos_);
         if (end == std::string::npos) fail("truncated: the file ends inside the image name");
@@ -131,7 +137,8 @@ std::map<int, ColmapCamera> read_cameras(const std::string& path) {
     return cameras;
 }
 
-std::vector<ColmapImage> read_images(const std::string& path, const std::map<int, ColmapCamera>& cameras) {
+std::vector<ColmapImage> read_images(const std::string& path, const std::map<int, ColmapCamera>& cameras,
+                                     ColmapContent content) {
     Reader in(path);
     std::vector<ColmapImage> images;
     const std::uint64_t n = in.count(4 + 7 * 8 + 4 + 1 + 8, "image");
@@ -145,7 +152,11 @@ std::vector<ColmapImage> read_images(const std::string& path, const std::map<int
         im.name = in.get_cstring();
         // Each observation is x, y (double) and point3D_id (int64, -1 for none); the ids become point indices
         // once points3D is read.
-        im.observations.resize(in.length(24, "POINTS2D"));
+        const std::uint64_t observations = in.length(24, "POINTS2D");
+        if (content == ColmapContent::PosesAndPoints)
+            in.skip(24 * observations);
+        else
+            im.observations.resize(observations);
         for (ColmapObservation& o : im.observations) {
             o.xy.x = in.get<double>();
             o.xy.y = in.get<double>();
@@ -159,26 +170,32 @@ std::vector<ColmapImage> read_images(const std::string& path, const std::map<int
 }
 
 // Appends the points to `model`; returns their POINT3D_IDs in file order.
-std::vector<std::uint64_t> read_points(const std::string& path, ColmapModel& model) {
+std::vector<std::uint64_t> read_points(const std::string& path, ColmapModel& model, ColmapContent content) {
     Reader in(path);
     const std::uint64_t n = in.count(8 + 3 * 8 + 3 + 8 + 8, "point");
+    const bool everything = content == ColmapContent::Everything;
     std::vector<std::uint64_t> ids;
     ids.reserve(n);
     model.point_xyz.reserve(n);
     model.point_rgb.reserve(n);
-    model.point_error.reserve(n);
-    model.point_tracks.reserve(n);
+    if (everything) model.point_error.reserve(n), model.point_tracks.reserve(n);
     for (std::uint64_t i = 0; i < n; ++i) {
         in.begin_record(i);
         ids.push_back(in.get<std::uint64_t>());
         Vec3f xyz, rgb;
         for (int k = 0; k < 3; ++k) xyz[k] = float(in.get<double>());
         for (int k = 0; k < 3; ++k) rgb[k] = float(in.get<std::uint8_t>()) / 255.0f;
-        model.point_error.push_back(in.get<double>());
-        std::vector<ColmapTrackElement>& track = model.point_tracks.emplace_back(in.length(8, "TRACK"));
-        for (ColmapTrackElement& e : track) {  // (image_id, point2D_idx) as two uint32
-            e.image_id = int(in.get<std::uint32_t>());
-            e.observation = int(in.get<std::uint32_t>());
+        const double error = in.get<double>();
+        const std::uint64_t track_length = in.length(8, "TRACK");
+        if (everything) {
+            model.point_error.push_back(error);
+            std::vector<ColmapTrackElement>& track = model.point_tracks.emplace_back(track_length);
+            for (ColmapTrackElement& e : track) {  // (image_id, point2D_idx) as two uint32
+                e.image_id = int(in.get<std::uint32_t>());
+                e.observation = int(in.get<std::uint32_t>());
+            }
+        } else {
+            in.skip(8 * track_length);
         }
         if (!std::isfinite(xyz.x) || !std::isfinite(xyz.y) || !std::isfinite(xyz.z))
             in.fail("point position has a NaN or Inf value");
@@ -198,11 +215,11 @@ void put(std::string& out, T value) {
 
 }  // namespace
 
-ColmapModel read_colmap_binary(const std::string& dir) {
+ColmapModel read_colmap_binary(const std::string& dir, ColmapContent content) {
     ColmapModel model;
     model.cameras = read_cameras(join(dir, "cameras.bin"));
-    model.images = read_images(join(dir, "images.bin"), model.cameras);
-    colmap_detail::index_observed_points(model, read_points(join(dir, "points3D.bin"), model));
+    model.images = read_images(join(dir, "images.bin"), model.cameras, content);
+    colmap_detail::index_observed_points(model, read_points(join(dir, "points3D.bin"), model, content));
     return model;
 }
 

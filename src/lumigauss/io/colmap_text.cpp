@@ -86,11 +86,12 @@ bool is_blank(char c) {
 
 // The blank-separated tokens of a line. A plain loop: string_view::find_first_of with a set of two took
 // about 70 instructions per byte, half of reading a 7 MB images.txt.
-std::vector<std::string_view> split(std::string_view line) {
+// At most `limit` of them when given (the rest of the line is not looked at).
+std::vector<std::string_view> split(std::string_view line, std::size_t limit = std::size_t(-1)) {
     std::vector<std::string_view> tokens;
     const char* p = line.data();
     const char* const end = p + line.size();
-    while (true) {
+    while (tokens.size() < limit) {
         while (p != end && is_blank(*p)) ++p;
         if (p == end) break;
         const char* const start = p;
@@ -161,7 +162,8 @@ std::vector<ColmapObservation> parse_observations_line(std::string_view line, co
     return observations;
 }
 
-std::vector<ColmapImage> read_images(const std::string& path, const std::map<int, ColmapCamera>& cameras) {
+std::vector<ColmapImage> read_images(const std::string& path, const std::map<int, ColmapCamera>& cameras,
+                                     ColmapContent content) {
     Lines lines(path);
     std::vector<ColmapImage> images;
     std::string_view line;
@@ -169,20 +171,22 @@ std::vector<ColmapImage> read_images(const std::string& path, const std::map<int
         images.push_back(parse_image_line(line, lines));
         colmap_detail::check_image(images.back(), cameras, path, lines.where());
         // The observations line always follows (empty when the image has none); at the end it may be absent.
-        if (lines.next(line)) images.back().observations = parse_observations_line(line, lines);
+        if (lines.next(line) && content == ColmapContent::Everything)
+            images.back().observations = parse_observations_line(line, lines);
     }
     lines.check_declared_count(images.size(), "images");
     return images;
 }
 
 // Appends the points to `model`; returns their POINT3D_IDs in file order.
-std::vector<std::uint64_t> read_points(const std::string& path, ColmapModel& model) {
+std::vector<std::uint64_t> read_points(const std::string& path, ColmapModel& model, ColmapContent content) {
     Lines lines(path);
+    const bool everything = content == ColmapContent::Everything;
     std::vector<std::uint64_t> ids;
     std::string_view line;
     while (lines.next_record(line)) {
-        const auto t = split(line);
-        if (t.size() < 8 || (t.size() - 8) % 2 != 0)
+        const auto t = everything ? split(line) : split(line, 8);
+        if (t.size() < 8 || (everything && (t.size() - 8) % 2 != 0))
             lines.fail("expected POINT3D_ID X Y Z R G B ERROR TRACK[] (pairs IMAGE_ID POINT2D_IDX)");
         ids.push_back(parse<std::uint64_t>(t[0], lines, "an integer POINT3D_ID"));
         Vec3f xyz, rgb;
@@ -196,6 +200,7 @@ std::vector<std::uint64_t> read_points(const std::string& path, ColmapModel& mod
             lines.fail("point position has a NaN or Inf value");
         model.point_xyz.push_back(xyz);
         model.point_rgb.push_back(rgb);
+        if (!everything) continue;
         model.point_error.push_back(parse<double>(t[7], lines, "a number ERROR"));
         std::vector<ColmapTrackElement>& track = model.point_tracks.emplace_back((t.size() - 8) / 2);
         for (std::size_t k = 0; k < track.size(); ++k) {
@@ -279,11 +284,11 @@ std::string points_text(const ColmapModel& model) {
 
 }  // namespace
 
-ColmapModel read_colmap_text(const std::string& dir) {
+ColmapModel read_colmap_text(const std::string& dir, ColmapContent content) {
     ColmapModel model;
     model.cameras = read_cameras(join(dir, "cameras.txt"));
-    model.images = read_images(join(dir, "images.txt"), model.cameras);
-    colmap_detail::index_observed_points(model, read_points(join(dir, "points3D.txt"), model));
+    model.images = read_images(join(dir, "images.txt"), model.cameras, content);
+    colmap_detail::index_observed_points(model, read_points(join(dir, "points3D.txt"), model, content));
     return model;
 }
 
