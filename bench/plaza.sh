@@ -17,7 +17,10 @@
 #   fast-no-sky-alpha       the sky masks do not push alpha to 0 (lambda_sky_alpha=0)
 #   fast-no-sky-free-reg    the normal/distortion losses also on sky pixels (sky_free_regularizers=false)
 #   fast-no-prune-end       nothing pruned after densification, as officially (prune_until_end=false)
+#   fast-no-empty-prune     surfels painting the sky (most of their weight on empty pixels) not removed
+#                           (empty_space_prune_share=0)
 #   fast-no-ground-seeds    no starting points on the bare ground under the cameras (ground_seeds=false)
+#   fast-no-ground          black below the horizon where no surfel covers a pixel (ground_backdrop=false)
 #   fast-no-horizon         the sky drawn in every direction, below the horizon too (sky_horizon_fade=0;
 #                           its gt-env then also fills holes with the true sky's lower half, as trained)
 #   fast-no-sky-masks       the scene's sky masks ignored (use_sky_masks=false): the background-explained
@@ -72,7 +75,9 @@ if [[ $ablations == 1 ]]; then
     add_row fast-no-sky-alpha "--preset fast --set lambda_sky_alpha=0"
     add_row fast-no-sky-free-reg "--preset fast --set sky_free_regularizers=false"
     add_row fast-no-prune-end "--preset fast --set prune_until_end=false"
+    add_row fast-no-empty-prune "--preset fast --set empty_space_prune_share=0"
     add_row fast-no-ground-seeds "--preset fast --set ground_seeds=false"
+    add_row fast-no-ground "--preset fast --set ground_backdrop=false"
     add_row fast-no-horizon "--preset fast --set sky_horizon_fade=0"
     add_row fast-no-sky-masks "--preset fast --set use_sky_masks=false"
     add_row fast-no-sky-masks-no-bg-alpha "--preset fast --set use_sky_masks=false --set lambda_background_alpha=0"

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <functional>
 
+#include "lumigauss/model/ground_albedo.h"
 #include "lumigauss/model/relightable_ply.h"
 #include "lumigauss/model/scene_record.h"
 #include "lumigauss/model/trained_run.h"
@@ -105,6 +106,18 @@ TEST(RelightTrainedRun, SkyHorizonIsTheTrainingCamerasMeanUpWithTheConfigAngles)
     EXPECT_NEAR(run.photo_centres[1].x, -3, 1e-12);  // R^T t = (3, 2, -1)
     EXPECT_NEAR(run.photo_centres[1].y, -2, 1e-12);
     EXPECT_NEAR(run.photo_centres[1].z, 1, 1e-12);
+    // Trained with the ground drawn below the horizon: its albedo is read off the run's surfels, as training
+    // read it.
+    EXPECT_EQ(run.sky_horizon.ground_albedo.x, 0.0f);
+    {
+        std::ofstream c(run_paths(dir).config);
+        c << "{\"sky_background\": true, \"sky_horizon_start\": 3, \"sky_horizon_fade\": 5, "
+             "\"ground_backdrop\": true}\n";
+    }
+    const TrainedRun grounded = load_trained_run(dir);
+    const Vec3f expected = ground_albedo(grounded.model, grounded.sky_horizon.up);
+    EXPECT_EQ(grounded.sky_horizon.ground_albedo.x, expected.x);
+    EXPECT_EQ(grounded.sky_horizon.ground_albedo.z, expected.z);
     // A run trained without a fade has no horizon.
     {
         std::ofstream c(run_paths(dir).config);

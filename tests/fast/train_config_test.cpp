@@ -139,6 +139,8 @@ std::vector<MemberChange> every_member() {
         {"prune_until_end", [](TrainConfig& c) { c.prune_until_end = true; }},
         {"densify_near_fraction", [](TrainConfig& c) { c.densify_near_fraction = 0.37; }},
         {"lambda_opacity", [](TrainConfig& c) { c.lambda_opacity = 0.01; }},
+        {"empty_space_prune_share", [](TrainConfig& c) { c.empty_space_prune_share = 0.6; }},
+        {"ground_backdrop", [](TrainConfig& c) { c.ground_backdrop = true; }},
         {"checkpoint_interval", [](TrainConfig& c) { c.checkpoint_interval = 0; }},
         {"log_interval", [](TrainConfig& c) { c.log_interval = 1; }},
     };
@@ -239,7 +241,8 @@ TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
     const std::set<std::string> improvements = {
         "init_normals_from_points", "sky_background",   "lambda_sky_alpha",      "sky_free_regularizers",
         "lambda_background_alpha",  "prune_until_end",  "densify_near_fraction", "downscale",
-        "sky_horizon_start",        "sky_horizon_fade", "ground_seeds"};
+        "sky_horizon_start",        "sky_horizon_fade", "ground_seeds",          "empty_space_prune_share",
+        "ground_backdrop"};
     for (const auto& [improved, base] : {std::pair{"default", "paper"}, std::pair{"fast", "paper-fast"}}) {
         SCOPED_TRACE(improved);
         const Json a = Json::parse(train_config_to_json(train_preset(improved)));
@@ -258,6 +261,8 @@ TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
     EXPECT_EQ(paper.lambda_sky_alpha, 0.0);
     EXPECT_EQ(paper.lambda_background_alpha, 0.0);
     EXPECT_EQ(paper.sky_horizon_fade, 0.0);
+    EXPECT_EQ(paper.empty_space_prune_share, 0.0);
+    EXPECT_FALSE(paper.ground_backdrop);
     EXPECT_FALSE(paper.ground_seeds);
 }
 
@@ -282,7 +287,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 66, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 68, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;
@@ -648,6 +653,8 @@ TEST(TrainConfigValidate, RejectsEachBadValueNamingTheKey) {
         {"sky_horizon_start", [](TrainConfig& c) { c.sky_horizon_start = -1; }},
         {"sky_horizon_fade", [](TrainConfig& c) { c.sky_horizon_fade = -1; }},
         {"sky_horizon_fade", [](TrainConfig& c) { c.sky_horizon_start = 60, c.sky_horizon_fade = 40; }},
+        {"empty_space_prune_share", [](TrainConfig& c) { c.empty_space_prune_share = -0.1; }},
+        {"empty_space_prune_share", [](TrainConfig& c) { c.empty_space_prune_share = 1.5; }},
     };
     for (const char* preset : {"paper", "fast"}) {
         for (const Case& c : cases) {
@@ -683,6 +690,7 @@ TEST(TrainConfigValidate, AcceptsTheAllowedEdgeCases) {
         [](TrainConfig& c) { c.densify_until = c.densify_from - 1; },  // no densification
         [](TrainConfig& c) { c.downscale = 8; },
         [](TrainConfig& c) { c.iterations = 1; },
+        [](TrainConfig& c) { c.empty_space_prune_share = 1.0; },  // removes none
     };
     for (std::size_t i = 0; i < allowed.size(); ++i) {
         TrainConfig c = train_preset("fast");

@@ -133,13 +133,14 @@ TEST(ViewSceneInfo, PassesTheRunsSkyHorizonToTheViewer) {
     const Camera cam = testing::test_camera();
     TrainedRun run = relight_test::in_memory_run(relight_test::random_model(cam, 4, 30), {"p0.jpg"});
     run.sky_background = true;
-    run.sky_horizon = {{0, -1, 0}, 4, 4};
+    run.sky_horizon = {{0, -1, 0}, 4, 4, {0.25f, 0.5f, 0.75f}};
     const nlohmann::json j =
         nlohmann::json::parse(scene_json(describe_scene(run, {}, parse_up_axis("-y"), cam)));
     EXPECT_EQ(j["sky_background"], true);
     EXPECT_EQ(j["sky_horizon"]["up"][1].get<double>(), -1.0);
     EXPECT_EQ(j["sky_horizon"]["start_degrees"].get<double>(), 4.0);
     EXPECT_EQ(j["sky_horizon"]["fade_degrees"].get<double>(), 4.0);
+    EXPECT_EQ(j["sky_horizon"]["ground_albedo"][2].get<double>(), 0.75);  // the ground drawn below it
 }
 
 TEST(ViewSceneInfo, UniformEnvironmentHasIrradianceOne) {

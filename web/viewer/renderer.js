@@ -136,7 +136,8 @@ export class SplatRenderer {
 
   // view: {R (rows), t, fx, fy, cx, cy, width, height}; env: Float32Array(27); mode: a MODES name;
   // ball: null or {mode: 0|1, size (pixels)}; sky: draw the light's sky behind the colour views;
-  // horizon: null or the scene's sky_horizon {up, start_degrees, fade_degrees} (where that sky ends).
+  // horizon: null or the scene's sky_horizon {up, start_degrees, fade_degrees, ground_albedo} (where that
+  // sky ends, and the ground drawn below).
   render(view, env, mode, ball, sky = false, horizon = null) {
     const gl = this.gl;
     const { width, height } = view;
@@ -191,6 +192,8 @@ export class SplatRenderer {
     gl.uniform3f(c.u.u_horizonUp, up[0], up[1], up[2]);
     gl.uniform2f(c.u.u_horizonSines, horizon ? sine(horizon.start_degrees) : 0,
                  horizon ? sine(horizon.start_degrees + horizon.fade_degrees) : 0);
+    const ground = horizon && horizon.ground_albedo ? horizon.ground_albedo : [0, 0, 0];
+    gl.uniform3f(c.u.u_groundAlbedo, ground[0], ground[1], ground[2]);
     this.setCamera(c.u, view);
     gl.uniform4f(c.u.u_intr, view.fx, view.fy, view.cx, view.cy);
     gl.uniform2f(c.u.u_size, width, height);

@@ -188,7 +188,8 @@ void main() {
 // The per-pixel step after blending: what the C++ does to the rasterised maps before writing PNGs.
 // With u_sky, the colour views are composited over the light's sky (shading/sky_colour.h: the radiance
 // along the pixel's ray, floored at 1e-4, to the power 1/2.2, clipped at 1), as `render --background sky`,
-// fading out below the horizon as the run was trained (sky_visibility in shading/sky_colour.h).
+// fading out below the horizon as the run was trained (sky_visibility in shading/sky_colour.h) into the
+// ground drawn there (ground_colour).
 export const COMPOSITE_FS = `#version 300 es
 precision highp float;
 uniform highp sampler2D u_accum;
@@ -197,6 +198,7 @@ uniform bool u_unitRange;
 uniform bool u_sky;
 uniform vec3 u_horizonUp;       // the training cameras' mean up
 uniform vec2 u_horizonSines;    // sines of the depressions where the sky starts to fade and is gone; y <= 0: none
+uniform vec3 u_groundAlbedo;    // the ground drawn where the sky has faded (ground_colour in sky_colour.h)
 uniform vec3 u_r0, u_r1, u_r2;  // world-to-camera rotation, rows
 uniform vec4 u_intr;            // fx, fy, cx, cy
 uniform vec2 u_size;
@@ -211,7 +213,8 @@ vec3 sky() {
     float depression = -dot(u_horizonUp, d);
     visible = clamp((u_horizonSines.y - depression) / max(u_horizonSines.y - u_horizonSines.x, 1e-6), 0.0, 1.0);
   }
-  return visible * min(pow(max(radiance(d), vec3(1e-4)), vec3(1.0 / 2.2)), vec3(1.0));
+  vec3 ground = u_groundAlbedo * intensity(irradiance(u_horizonUp));
+  return visible * min(pow(max(radiance(d), vec3(1e-4)), vec3(1.0 / 2.2)), vec3(1.0)) + (1.0 - visible) * ground;
 }
 void main() {
   vec4 c = texelFetch(u_accum, ivec2(gl_FragCoord.xy), 0);

@@ -45,6 +45,7 @@ Image true_sky_image(const RelightableRun& run, const GtSceneMeta& meta, TruePan
         sky.pixels = panorama;
         sky.factor = im.exposure * Vec3d{scale[0], scale[1], scale[2]};
         sky.horizon = run.sky_horizon;
+        sky.ground = horizon_ground_colour(scaled_true_env(meta, im, scale), run.sky_horizon);
         return panorama_sky_image(camera, sky);
     }
     return sky_image(camera, scaled_true_env(meta, im, scale), nullptr, run.sky_horizon);

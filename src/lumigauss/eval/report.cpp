@@ -272,6 +272,11 @@ std::string gt_env_report_markdown(const GtEnvResult& r, const ReportSources& sr
                  fmt("%.3g", h.start_degrees + h.fade_degrees) +
                  " deg below the horizon of the training cameras' mean up, as in training (a hole in the "
                  "ground is not filled with the true environment's lower half)";
+        const Vec3f g = h.ground_albedo;
+        if (h.fade_degrees > 0 && (g.x > 0 || g.y > 0 || g.z > 0))
+            s += "; below it the ground the run was trained with is drawn (albedo " + fmt("%.3f", g.x) + " " +
+                 fmt("%.3f", g.y) + " " + fmt("%.3f", g.z) +
+                 ", the median of its surfels facing up, under the same light at the up normal)";
         s += ".\n";
     }
     s += "- The test photo's exposure (meta.json) is applied: it is the camera's setting, recorded with the "

@@ -1,5 +1,7 @@
 #include "lumigauss/model/trained_run.h"
 
+#include "lumigauss/model/ground_albedo.h"
+
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
@@ -126,6 +128,9 @@ TrainedRun load_trained_run(const std::string& dir) {
         if (c.is_object() && c.contains("sky_background") && c["sky_background"].is_boolean())
             run.sky_background = c["sky_background"].get<bool>();
         run.sky_horizon = recorded_sky_horizon(c, run.photos_up);
+        if (c.is_object() && c.contains("ground_backdrop") && c["ground_backdrop"].is_boolean() &&
+            c["ground_backdrop"].get<bool>() && run.sky_horizon.fade_degrees > 0)
+            run.sky_horizon.ground_albedo = ground_albedo(run.model, run.sky_horizon.up);
     }
     return run;
 }

@@ -34,7 +34,8 @@ struct TrainedRun {
     std::vector<Mat3d> photo_rotations;
     std::vector<Vec3d> photo_centres;
     // Where that sky ends below the horizon: config.json sky_horizon_start/fade, about photos_up (no horizon
-    // without it, as the run was trained then).
+    // without it, as the run was trained then), and with config.json ground_backdrop the ground drawn there
+    // (its albedo from the surfels, model/ground_albedo.h, as training computed it at its last iteration).
     SkyHorizon sky_horizon;
 
     // Embedding index of the training photo called exactly `name`, or -1.

@@ -48,7 +48,8 @@ Image panorama_sky_image(const Camera& camera, const PanoramaSky& sky) {
             const Vec3d radiance = sample_equirect(*sky.pixels, e.row, e.col);
             const float visible = visibility.empty() ? 1.0f : visibility[std::size_t(y * camera.width + x)];
             for (int c = 0; c < 3; ++c)
-                out.at(x, y, c) = visible * float(sky_channel(sky.factor[c] * radiance[c]));
+                out.at(x, y, c) = visible * float(sky_channel(sky.factor[c] * radiance[c])) +
+                                  (1.0f - visible) * sky.ground[c];
         }
     return out;
 }

@@ -17,12 +17,13 @@ struct PanoramaSky {
     Mat3d frame = Mat3d::identity();  // world direction = frame * panorama direction
     Vec3d factor{1, 1, 1};            // the light's scale per channel (--exposure, --match-exposure)
     Vec3d up{0, 0, 1};
-    double degrees = 0;  // the environment turned about `up` (counter-clockwise seen from above)
-    SkyHorizon horizon;  // where the sky ends below the horizon (none by default: drawn as it is)
+    double degrees = 0;     // the environment turned about `up` (counter-clockwise seen from above)
+    SkyHorizon horizon;     // where the sky ends below the horizon (none by default: drawn as it is)
+    Vec3f ground{0, 0, 0};  // display colour drawn where the sky has faded (horizon_ground_colour)
 };
 
-// sky_visibility * sky_channel(factor * pano(R(-degrees) d)) per pixel, bilinear in the panorama (columns
-// wrap).
+// sky_visibility * sky_channel(factor * pano(R(-degrees) d)) + (1 - sky_visibility) * ground per pixel,
+// bilinear in the panorama (columns wrap).
 Image panorama_sky_image(const Camera& camera, const PanoramaSky& sky);
 
 // A point of an equirectangular image, bilinear; columns wrap around, rows clamp.

@@ -72,6 +72,14 @@ LG_HD inline T sky_visibility(Vec3<T> up, T start_sine, T end_sine, Vec3<T> dir)
     return (end_sine - depression) / (end_sine - start_sine);
 }
 
+// The ground drawn where the sky has faded below the horizon: a surface of (activated) albedo `albedo`
+// facing the unit `up`, lit by the environment without shadows, as a surfel of the ground is drawn
+// (surfel_shading.h). A hole in the ground seen from a new viewpoint is then drawn as ground, not black.
+template <typename T>
+LG_HD inline Vec3<T> ground_colour(const ShCoeffs<T>& env, Vec3<T> up, Vec3<T> albedo) {
+    return lights_to_colour(irradiance(env, up), albedo);
+}
+
 // Display-space colour of a sky radiance.
 template <typename T>
 LG_HD inline Vec3<T> sky_colour_of(Vec3<T> radiance) {

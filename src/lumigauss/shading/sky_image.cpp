@@ -58,6 +58,12 @@ std::vector<float> sky_visibility_image(const Camera& camera, const SkyHorizon& 
     return out;
 }
 
+Vec3f horizon_ground_colour(const ShCoeffs<float>& env, const SkyHorizon& horizon) {
+    const Vec3f a = horizon.ground_albedo;
+    if (!(horizon.fade_degrees > 0) || (a.x == 0 && a.y == 0 && a.z == 0)) return {};
+    return ground_colour(env, horizon_sines(horizon).up, a);
+}
+
 void sky_pixels(std::span<const Vec3f> rays, const ShCoeffs<float>& env, const Sh4Coeffs<float>* residual,
                 SkyPixels& out, const SkyHorizon& horizon) {
     out.radiance.resize(3 * rays.size());
@@ -65,20 +71,21 @@ void sky_pixels(std::span<const Vec3f> rays, const ShCoeffs<float>& env, const S
     const bool has_horizon = horizon.fade_degrees > 0;
     out.visibility.resize(has_horizon ? rays.size() : 0);
     const HorizonSines h = has_horizon ? horizon_sines(horizon) : HorizonSines{{0, 0, 1}, 0, 0};
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), kChunk),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t p = r.begin(); p < r.end(); ++p) {
-                              const Vec3f radiance = sky_radiance(env, residual, rays[p]);
-                              const float visible =
-                                  has_horizon ? sky_visibility(h.up, h.start, h.end, rays[p]) : 1.0f;
-                              if (has_horizon) out.visibility[p] = visible;
-                              const Vec3f colour = visible * sky_colour_of(radiance);
-                              for (int c = 0; c < 3; ++c) {
-                                  out.radiance[3 * p + std::size_t(c)] = radiance[c];
-                                  out.colour[3 * p + std::size_t(c)] = colour[c];
-                              }
-                          }
-                      });
+    const Vec3f ground = horizon_ground_colour(env, horizon);
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, rays.size(), kChunk),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t p = r.begin(); p < r.end(); ++p) {
+                const Vec3f radiance = sky_radiance(env, residual, rays[p]);
+                const float visible = has_horizon ? sky_visibility(h.up, h.start, h.end, rays[p]) : 1.0f;
+                if (has_horizon) out.visibility[p] = visible;
+                const Vec3f colour = visible * sky_colour_of(radiance) + (1.0f - visible) * ground;
+                for (int c = 0; c < 3; ++c) {
+                    out.radiance[3 * p + std::size_t(c)] = radiance[c];
+                    out.colour[3 * p + std::size_t(c)] = colour[c];
+                }
+            }
+        });
 }
 
 Image sky_image(const Camera& camera, const ShCoeffs<float>& env, const Sh4Coeffs<float>* residual,

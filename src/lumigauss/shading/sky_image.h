@@ -24,10 +24,16 @@ struct SkyHorizon {
     Vec3f up{0, 0, 1};
     float start_degrees = 0;  // below the horizon, where the sky starts to fade
     float fade_degrees = 0;   // over how many degrees it fades to 0; 0: the environment is drawn everywhere
+    // Where the sky has faded, the ground of this albedo is drawn (ground_colour, sky_colour.h); 0: black.
+    Vec3f ground_albedo{0, 0, 0};
 };
 
+// The display colour of the horizon's ground under `env` (0 without a horizon or a ground albedo).
+Vec3f horizon_ground_colour(const ShCoeffs<float>& env, const SkyHorizon& horizon);
+
 // The sky along every ray: radiance (environment + residual, when given), display colour times the ray's
-// visibility (sky_visibility), and that visibility (empty when there is no horizon).
+// visibility (sky_visibility) plus the horizon's ground times the rest, and that visibility (empty when
+// there is no horizon). The ground takes the light as it is: the backward passes nothing through it.
 struct SkyPixels {
     std::vector<float> radiance, colour, visibility;
 };

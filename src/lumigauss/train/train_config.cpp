@@ -88,6 +88,7 @@ constexpr std::array kFields = {
     LUMIGAUSS_FIELD(sky_background),
     LUMIGAUSS_FIELD(sky_horizon_start),
     LUMIGAUSS_FIELD(sky_horizon_fade),
+    LUMIGAUSS_FIELD(ground_backdrop),
     LUMIGAUSS_FIELD(sky_residual),
     LUMIGAUSS_FIELD(lambda_sky_residual),
     LUMIGAUSS_FIELD(lr_sky_residual),
@@ -105,6 +106,7 @@ constexpr std::array kFields = {
     LUMIGAUSS_FIELD(mask_mode),
     LUMIGAUSS_FIELD(prune_until_end),
     LUMIGAUSS_FIELD(densify_near_fraction),
+    LUMIGAUSS_FIELD(empty_space_prune_share),
     LUMIGAUSS_FIELD(lambda_opacity),
     LUMIGAUSS_FIELD(checkpoint_interval),
     LUMIGAUSS_FIELD(log_interval),
@@ -392,12 +394,14 @@ void add_improvements(TrainConfig& config) {
     // below it (demo scene: 19 % of the test views' sky covered, normals 40 deg off).
     config.sky_horizon_start = 4.0;
     config.sky_horizon_fade = 4.0;
+    config.ground_backdrop = true;
     config.lambda_sky_alpha = 0.1;
     config.sky_free_regularizers = true;
     config.lambda_background_alpha = 0.1;
     config.prune_until_end = true;
     config.densify_near_fraction = 0.37;  // Pixel-GS's value; -5 deg of test-view normal error on plaza
-    config.downscale = 0;                 // -r auto: large photos at most 1600 px (run_all.sh's -r 1 is off)
+    config.empty_space_prune_share = 0.5;
+    config.downscale = 0;  // -r auto: large photos at most 1600 px (run_all.sh's -r 1 is off)
 }
 
 }  // namespace
@@ -602,6 +606,8 @@ void validate_train_config(const TrainConfig& c) {
     require(c.background_match_tolerance > 0.0, "background_match_tolerance", c.background_match_tolerance,
             "must be > 0");
     require(c.background_alpha_from >= 0, "background_alpha_from", c.background_alpha_from, "must be >= 0");
+    require(c.empty_space_prune_share >= 0.0 && c.empty_space_prune_share <= 1.0, "empty_space_prune_share",
+            c.empty_space_prune_share, "must be in [0, 1] (0: off)");
     if (c.mask_mode != "transient" && c.mask_mode != "object")
         invalid("mask_mode", "'" + c.mask_mode + "'", "must be transient or object");
 

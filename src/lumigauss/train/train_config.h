@@ -93,6 +93,10 @@ struct TrainConfig {
     // lower half, holes were painted by it and the learned lights grew a bright floor.
     double sky_horizon_start = 0.0;
     double sky_horizon_fade = 0.0;
+    // Where the sky has faded below the horizon, the ground is drawn instead of black: the median albedo
+    // of the surfels facing up (model/ground_albedo.h) lit by the photo's light. Holes in the near ground
+    // of a new viewpoint then look like ground.
+    bool ground_backdrop = false;
     // Where sky masks exist: alpha pushed to 0 on sky pixels (mean alpha over the sky mask eroded by
     // sky_mask_erosion pixels), the environment supervised by the sky pixels it must reproduce (L1 plus
     // 0.1 x (1 - cosine) per pixel, saturated pixels skipped), and the normal/distortion losses kept off the
@@ -135,6 +139,10 @@ struct TrainConfig {
     bool prune_until_end = false;
     double densify_near_fraction = 0.0;
     double lambda_opacity = 0.0;
+    // After densification, once per opacity_reset_interval and at the end: surfels with more than this
+    // share of their blend weight in the training photos on pixels that must stay empty (sky mask, an
+    // object's outside, or the background-explained pixels) are removed (train/empty_space_prune.h); 0 = off.
+    double empty_space_prune_share = 0.0;
 
     // Run bookkeeping (not in the official code).
     std::int64_t checkpoint_interval = 1000;  // iterations between checkpoints; 0 = only at the end/interrupt

@@ -8,10 +8,12 @@
 #include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/io/image_metrics.h"
 #include "lumigauss/io/scene_extent.h"
+#include "lumigauss/model/ground_albedo.h"
 #include "lumigauss/render/background.h"
 #include "lumigauss/render/rasterizer.h"
 #include "lumigauss/shading/sky_image.h"
 #include "lumigauss/train/depth_normal.h"
+#include "lumigauss/train/empty_space_prune.h"
 #include "lumigauss/train/image_losses.h"
 #include "lumigauss/train/physical_losses.h"
 #include "lumigauss/train/sky_losses.h"
@@ -190,6 +192,9 @@ NonFiniteError::NonFiniteError(std::int64_t iteration_, std::string term_)
 struct Trainer::ViewMasks {
     std::vector<float> photometric;  // the photometric loss's mask (the photo's mask as loaded)
     std::vector<float> empty;        // pixels that must stay empty: the eroded sky, or an object's outside
+    // The same before the erosion, which keeps the alpha penalty off the edges: a surfel on an edge has
+    // under half its weight on either side, and a painter of the sky band at the horizon just over half.
+    std::vector<float> empty_unshrunk;
     std::vector<float> sky;          // pixels whose photo shows the sky (eroded sky mask); empty: no sky mask
     std::vector<float> regularizer;  // the normal/distortion losses' mask
 };
@@ -304,15 +309,19 @@ void Trainer::prepare_view_masks() {
                 outside.pixels[p] = (1.0f - outside.pixels[p]) *
                                     (view.coverage.pixels.empty() ? 1.0f : view.coverage.pixels[p]);
             m.empty = eroded_mask(outside, c.sky_mask_erosion);
+            m.empty_unshrunk = outside.pixels;
         } else {
             m.empty = m.sky;
+            if (!m.sky.empty()) m.empty_unshrunk = view.sky.pixels;
         }
     }
 }
 
 SkyHorizon Trainer::sky_horizon() const {
     const TrainConfig& c = state_.config;
-    return {up_, float(c.sky_horizon_start), float(c.sky_horizon_fade)};
+    SkyHorizon horizon{up_, float(c.sky_horizon_start), float(c.sky_horizon_fade)};
+    if (c.ground_backdrop) horizon.ground_albedo = ground_albedo(state_.model, up_);
+    return horizon;
 }
 
 void Trainer::set_backend(RasterBackend backend) {
@@ -581,26 +590,86 @@ void Trainer::check_finite(std::int64_t it, const StepReport& r) const {
             throw NonFiniteError(it, std::string("gradient of lighting ") + mlp_group_name(MlpGroup(g)));
 }
 
+void Trainer::post_densification_prune(std::int64_t it, StepReport& report) {
+    const TrainConfig& c = state_.config;
+    GaussianModel& model = state_.model;
+    // Beyond the paper: the prune goes on (nothing else removes a surfel once densification ends).
+    const bool prune = c.prune_until_end && it % c.densify_interval == 0 && it < c.iterations;
+    // The sweep over every photo costs about as many renders as there are photos: once per opacity-reset
+    // rhythm, and at the end so that the saved model holds no painter.
+    const bool sweep =
+        c.empty_space_prune_share > 0 && (it % c.opacity_reset_interval == 0 || it == c.iterations);
+    if (!prune && !sweep) return;
+    const auto t0 = Clock::now();
+    if (prune) {
+        // The last opacity reset left every opacity at 0.01: the opacity rule waits half a reset interval
+        // for the surfels that matter to recover (densification's own prune waits a whole interval).
+        const std::int64_t last_reset =
+            ((c.densify_until - 1) / c.opacity_reset_interval) * c.opacity_reset_interval;
+        const bool opacity_rule = it - last_reset >= c.opacity_reset_interval / 2;
+        report.densified.pruned = model.prune(opacity_rule ? c.min_opacity : 0.0,
+                                              DensifyOptions{}.world_size_fraction * state_.scene_extent);
+        report.prune_ran = true;
+    }
+    if (sweep) {
+        report.empty_space_pruned = prune_empty_space_painters();
+        report.empty_space_swept = true;
+    }
+    model.zero_grad();
+    times_.densify += seconds_since(t0);
+}
+
+std::vector<float> Trainer::empty_pixels(int v) {
+    const TrainConfig& c = state_.config;
+    const ViewMasks& masks = masks_[std::size_t(v)];
+    if (!masks.empty_unshrunk.empty()) return masks.empty_unshrunk;
+    const bool match_background =
+        c.sky_background && c.lambda_background_alpha > 0 && masks.sky.empty() && c.mask_mode != "object";
+    if (!match_background) return {};
+    const TrainView& view = views_[std::size_t(v)];
+    Scratch& s = *scratch_;
+    const bool residual = uses_sky_residual(c);
+    Sh4Coeffs<float> sky_residual{};
+    if (residual) sky_residual = state_.sky_residuals.get(v);
+    s.rays = pixel_ray_directions(view.camera);
+    sky_pixels(s.rays, environment(v), residual ? &sky_residual : nullptr, s.sky, sky_horizon());
+    return background_match_mask(view.rgb.pixels, s.sky.colour, masks.photometric, s.rays, up_,
+                                 view.rgb.width, view.rgb.height, c.background_match_tolerance);
+}
+
+std::size_t Trainer::prune_empty_space_painters() {
+    GaussianModel& model = state_.model;
+    EmptySpaceWeights weights;
+    weights.reset(model.size());
+    SurfelBatch<float> geometry;
+    std::vector<float> constrained;
+    bool any_empty = false;
+    model.activated(geometry);
+    for (int v = 0; v < int(views_.size()); ++v) {
+        const std::vector<float> empty = empty_pixels(v);
+        any_empty = any_empty || !empty.empty();
+        // The pixels the photo constrains: its photometric mask, and the ones that must stay empty (an
+        // object mask's outside is outside the photometric mask).
+        constrained = masks_[std::size_t(v)].photometric;
+        for (std::size_t p = 0; p < empty.size(); ++p) constrained[p] = std::max(constrained[p], empty[p]);
+        add_empty_space_weights(*scratch_->rasterizer, views_[std::size_t(v)].camera, geometry, constrained,
+                                empty, weights);
+    }
+    if (!any_empty) return 0;
+    std::size_t removed = 0;
+    const std::vector<std::uint8_t> keep =
+        keep_outside_empty_space(weights, state_.config.empty_space_prune_share, removed);
+    if (removed > 0) model.keep_rows(keep);
+    return removed;
+}
+
 void Trainer::densify_step(std::int64_t it, Stage stage, StepReport& report) {
     const TrainConfig& c = state_.config;
     GaussianModel& model = state_.model;
     // Official: only while it < densify_until and outside stage 2.
     if (stage == Stage::TransferFitting) return;
     if (it >= c.densify_until) {
-        // Beyond the paper: the prune goes on (nothing else removes a surfel once densification ends).
-        if (c.prune_until_end && it % c.densify_interval == 0 && it < c.iterations) {
-            const auto t0 = Clock::now();
-            // The last opacity reset left every opacity at 0.01: the opacity rule waits half a reset interval
-            // for the surfels that matter to recover (densification's own prune waits a whole interval).
-            const std::int64_t last_reset =
-                ((c.densify_until - 1) / c.opacity_reset_interval) * c.opacity_reset_interval;
-            const bool opacity_rule = it - last_reset >= c.opacity_reset_interval / 2;
-            report.densified.pruned = model.prune(opacity_rule ? c.min_opacity : 0.0,
-                                                  DensifyOptions{}.world_size_fraction * state_.scene_extent);
-            report.prune_ran = true;
-            model.zero_grad();
-            times_.densify += seconds_since(t0);
-        }
+        post_densification_prune(it, report);
         return;
     }
     const auto t0 = Clock::now();

@@ -70,6 +70,10 @@ struct StepReport {
     DensifyReport densified{};
     bool densify_ran = false, opacity_reset = false;
     bool prune_ran = false;  // the prune alone, after densification (prune_until_end)
+    // Surfels removed for painting empty space (config empty_space_prune_share, train/empty_space_prune.h);
+    // the sweep over the photos ran this iteration when empty_space_swept.
+    std::size_t empty_space_pruned = 0;
+    bool empty_space_swept = false;
 };
 
 // The state that fully determines the rest of a run (what a checkpoint stores).
@@ -124,7 +128,7 @@ class Trainer {
     // found = false and no points).
     const GroundSeeds& ground() const { return ground_; }
     // Where the sky drawn behind the surfels ends below the horizon (config sky_horizon_*; the cameras'
-    // mean up).
+    // mean up), and the ground drawn there (config ground_backdrop: the current surfels' ground albedo).
     SkyHorizon sky_horizon() const;
     // The training view used at a given iteration (a fresh permutation of the photos per epoch).
     int view_for_iteration(std::int64_t iteration) const;
@@ -147,6 +151,15 @@ class Trainer {
     void render_step(std::int64_t iteration, Stage stage, StepReport& report);
     void physical_step(std::int64_t iteration, Stage stage, StepReport& report);
     void densify_step(std::int64_t iteration, Stage stage, StepReport& report);
+    // After densification: the prune goes on (prune_until_end) and painters of empty space are removed.
+    void post_densification_prune(std::int64_t iteration, StepReport& report);
+    // Renders every training photo's geometry and removes the surfels with more than
+    // empty_space_prune_share of their blend weight on pixels that must stay empty. Returns how many.
+    std::size_t prune_empty_space_painters();
+    // The pixels of training photo `view` that must stay empty: its sky or an object's outside, or
+    // without masks (with a sky background and lambda_background_alpha) the pixels whose sky the photo
+    // already shows under its current light; empty when the photo has none.
+    std::vector<float> empty_pixels(int view);
     void check_finite(std::int64_t iteration, const StepReport& report) const;
     void optimizer_step(std::int64_t iteration, Stage stage);
 

@@ -192,8 +192,8 @@ TrainingOutcome TrainingRun::run(std::int64_t stop_after, const std::function<bo
             save_run_model(paths_, trainer_->state(), trainer_->exposures());
         HeldOutLog held_out;
         if (score_now) held_out = score_snapshot();
-        const bool log_now = r.iteration % config.log_interval == 0 || r.densify_ran || r.prune_ran || done ||
-                             held_out.score || !held_out.error.empty();
+        const bool log_now = r.iteration % config.log_interval == 0 || r.densify_ran || r.prune_ran ||
+                             r.empty_space_swept || done || held_out.score || !held_out.error.empty();
         if (log_now) log << step_log_line(r, elapsed(), held_out) << '\n' << std::flush;
         if (checkpoint_now) write_progress(paths_, *trainer_, kPreviewViews);
         on_step(r);

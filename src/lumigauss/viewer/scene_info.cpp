@@ -97,7 +97,8 @@ std::string scene_json(const ViewerScene& scene) {
     const SkyHorizon& h = scene.sky_horizon;
     j["sky_horizon"] = h.fade_degrees > 0 ? json{{"up", vec_json(h.up.cast<double>())},
                                                  {"start_degrees", h.start_degrees},
-                                                 {"fade_degrees", h.fade_degrees}}
+                                                 {"fade_degrees", h.fade_degrees},
+                                                 {"ground_albedo", vec_json(h.ground_albedo.cast<double>())}}
                                           : json(nullptr);
     return j.dump();
 }

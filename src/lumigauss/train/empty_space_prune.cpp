@@ -1,0 +1,49 @@
+#include "lumigauss/train/empty_space_prune.h"
+
+#include <string>
+
+#include "lumigauss/util/error.h"
+
+namespace lumigauss {
+
+void add_empty_space_weights(Rasterizer& rasterizer, const Camera& camera, SurfelBatch<float>& geometry,
+                             std::span<const float> constrained, std::span<const float> empty,
+                             EmptySpaceWeights& weights) {
+    const std::size_t pixels = std::size_t(camera.width) * std::size_t(camera.height);
+    if (constrained.size() != pixels || (!empty.empty() && empty.size() != pixels))
+        throw Error("empty-space weights: the masks hold " + std::to_string(constrained.size()) + " and " +
+                    std::to_string(empty.size()) + " values for a " + std::to_string(camera.width) + " x " +
+                    std::to_string(camera.height) + " image");
+    if (weights.constrained.size() != geometry.size()) weights.reset(geometry.size());
+    // Channel 0 sums the weight over the constrained pixels, channel 1 over the empty ones.
+    geometry.channels = 2;
+    geometry.colors.assign(2 * geometry.size(), 1.0f);
+    RasterImages<float> images;
+    rasterizer.forward(camera, geometry, RasterSettings<float>{}, images);
+    RasterImageGrads<float> grads;
+    grads.width = camera.width, grads.height = camera.height, grads.channels = 2;
+    grads.color.assign(2 * pixels, 0.0f);
+    for (std::size_t p = 0; p < pixels; ++p) {
+        grads.color[2 * p] = constrained[p];
+        grads.color[2 * p + 1] = empty.empty() ? 0.0f : empty[p];
+    }
+    SurfelGrads<float> sums;
+    rasterizer.backward(geometry, grads, sums);
+    for (std::size_t i = 0; i < geometry.size(); ++i) {
+        weights.constrained[i] += double(sums.colors[2 * i]);
+        weights.empty[i] += double(sums.colors[2 * i + 1]);
+    }
+}
+
+std::vector<std::uint8_t> keep_outside_empty_space(const EmptySpaceWeights& weights, double max_share,
+                                                   std::size_t& removed) {
+    const std::size_t n = weights.constrained.size();
+    std::vector<std::uint8_t> keep(n, 1);
+    removed = 0;
+    for (std::size_t i = 0; i < n; ++i)
+        if (weights.constrained[i] > 0 && weights.empty[i] > max_share * weights.constrained[i])
+            keep[i] = 0, ++removed;
+    return keep;
+}
+
+}  // namespace lumigauss

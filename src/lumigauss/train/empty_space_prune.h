@@ -1,0 +1,42 @@
+#pragma once
+// Surfels that paint empty space. A surfel whose blend weight in the training photos falls mostly on pixels
+// that must stay empty (the sky of a sky mask, the outside of an object mask, or without masks the pixels
+// whose sky the photo already shows) is a sky painter: where the sky drawn behind the surfels is a poor
+// model of the photo's sky (a degree-2 SH near the horizon), large faint surfels survive the alpha penalty
+// by painting it, and from another viewpoint they hang in front of the scene as a veil. Summed over all the
+// photos, a surface the photos see has most of its weight on the scene; a painter has most on the sky.
+//
+// What a surfel contributes to pixel p is its blend weight w_ip = alpha_ip T_ip, so that for colours of 1
+// the colour gradient of surfel i under a pixel gradient g_p is sum_p w_ip g_p: one forward and one
+// backward per photo give both sums.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "lumigauss/io/camera.h"
+#include "lumigauss/render/raster_types.h"
+#include "lumigauss/render/rasterizer.h"
+
+namespace lumigauss {
+
+// Per surfel, summed over the photos added: its blend weight over the pixels a photo constrains, and the
+// part of it on pixels that must stay empty.
+struct EmptySpaceWeights {
+    std::vector<double> constrained, empty;
+
+    void reset(std::size_t surfels) { constrained.assign(surfels, 0.0), empty.assign(surfels, 0.0); }
+};
+
+// Adds one photo. `geometry` holds the surfels as rasterized (SurfelModel::activated; its colours are
+// overwritten); `constrained` and `empty` hold one weight per pixel of the camera's image (empty <=
+// constrained: the pixels that must stay empty are constrained too). `empty` may be empty (none).
+void add_empty_space_weights(Rasterizer& rasterizer, const Camera& camera, SurfelBatch<float>& geometry,
+                             std::span<const float> constrained, std::span<const float> empty,
+                             EmptySpaceWeights& weights);
+
+// 0 for the surfels with more than `max_share` of their weight on empty pixels, 1 for the others (a
+// surfel no photo sees is kept: nothing says what it is). `removed` counts the zeros.
+std::vector<std::uint8_t> keep_outside_empty_space(const EmptySpaceWeights& weights, double max_share,
+                                                   std::size_t& removed);
+
+}  // namespace lumigauss

@@ -1,0 +1,158 @@
+// Surfels that paint empty space (train/empty_space_prune.h): the blend-weight sums are the colour a surfel
+// alone would give the masked pixels, the decision keeps the surfels that mostly cover the scene, and a
+// training run removes a surfel planted in its photos' sky (issue #25: large faint surfels painting a sky
+// that the degree-2 environment draws badly survived to the end of training and hung as a veil in front of
+// novel views; eval's sky_mean_alpha measured it).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "fast/trainer_test_util.h"
+#include "lumigauss/math/quaternion.h"
+#include "lumigauss/render/rasterizer.h"
+#include "lumigauss/train/empty_space_prune.h"
+#include "support/random_surfels.h"
+
+namespace lumigauss {
+namespace {
+
+using testing::random_surfels;
+using testing::RandomSceneOptions;
+
+// Channel 0 of a render where only surfel `i` has colour 1: its blend weight in every pixel.
+std::vector<float> weights_of(Rasterizer& r, const Camera& cam, SurfelBatch<float> s, std::size_t i) {
+    s.channels = 1;
+    s.colors.assign(s.size(), 0.0f);
+    s.colors[i] = 1.0f;
+    RasterImages<float> img;
+    r.forward(cam, s, RasterSettings<float>{}, img);
+    return img.color;
+}
+
+TEST(EmptySpacePrune, WeightsAreEachSurfelsColourOverTheMaskedPixels) {
+    const Camera cam = testing::test_camera(64, 48);
+    RandomSceneOptions o;
+    o.count = 60;
+    o.min_scale = 0.1, o.max_scale = 0.6;
+    SurfelBatch<float> s = random_surfels<float>(cam, 5, o);
+    const std::size_t pixels = std::size_t(cam.width * cam.height);
+    std::vector<float> constrained(pixels), empty(pixels);
+    for (int y = 0; y < cam.height; ++y)
+        for (int x = 0; x < cam.width; ++x) {
+            constrained[std::size_t(y * cam.width + x)] = y < 40 ? 1.0f : 0.25f;  // a partly masked photo
+            empty[std::size_t(y * cam.width + x)] = x < 20 ? 1.0f : 0.0f;         // its sky on the left
+        }
+    const auto r = make_rasterizer(RasterBackend::Cpu);
+    EmptySpaceWeights w;
+    SurfelBatch<float> geometry = s;
+    add_empty_space_weights(*r, cam, geometry, constrained, empty, w);
+    add_empty_space_weights(*r, cam, geometry, constrained, {}, w);  // a second photo without empty pixels
+    ASSERT_EQ(w.constrained.size(), s.size());
+    int seen = 0, partly_empty = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        const std::vector<float> alone = weights_of(*r, cam, s, i);
+        double c = 0, e = 0;
+        for (std::size_t p = 0; p < pixels; ++p) c += alone[p] * constrained[p], e += alone[p] * empty[p];
+        EXPECT_NEAR(w.constrained[i], 2 * c, 1e-4 * (1 + c)) << "surfel " << i;
+        EXPECT_NEAR(w.empty[i], e, 1e-4 * (1 + e)) << "surfel " << i;
+        seen += c > 1 ? 1 : 0;
+        partly_empty += e > 0.1 && e < c ? 1 : 0;
+    }
+    EXPECT_GE(seen, 20);  // the scene is not degenerate: surfels are seen, some partly on the empty side
+    EXPECT_GE(partly_empty, 3);
+}
+
+TEST(EmptySpacePrune, RemovesTheSurfelsMostlyOnEmptyPixels) {
+    EmptySpaceWeights w;
+    w.constrained = {10, 10, 0, 10, 4};
+    w.empty = {6, 4, 0, 5, 4};
+    std::size_t removed = 99;
+    const std::vector<std::uint8_t> keep = keep_outside_empty_space(w, 0.5, removed);
+    EXPECT_EQ(keep, (std::vector<std::uint8_t>{0, 1, 1, 1, 0}));  // unseen kept; exactly half kept
+    EXPECT_EQ(removed, 2u);
+}
+
+TEST(EmptySpacePrune, RejectsMasksOfAnotherSize) {
+    const Camera cam = testing::test_camera(16, 12);
+    SurfelBatch<float> s = random_surfels<float>(cam, 1, RandomSceneOptions{});
+    const auto r = make_rasterizer(RasterBackend::Cpu);
+    EmptySpaceWeights w;
+    std::vector<float> wrong(10, 1.0f);
+    EXPECT_THROW(add_empty_space_weights(*r, cam, s, wrong, {}, w), Error);
+}
+
+// A large opaque surfel standing in the sky of the first training photo, `distance` in front of it, facing
+// it.
+std::vector<float> painter_row(const TrainView& view, ModelParam p, double distance) {
+    const Camera& cam = view.camera;
+    // The sky pixel nearest the top centre.
+    int px = cam.width / 2, py = 0;
+    for (int y = 0; y < cam.height; ++y)
+        if (view.sky.at(px, y, 0) > 0.5f) {
+            py = y + 2;
+            break;
+        }
+    const Vec3d dir_cam = normalize(Vec3d{(px + 0.5 - cam.cx) / cam.fx, (py + 0.5 - cam.cy) / cam.fy, 1.0});
+    const Mat3d to_world = transpose(cam.rotation);
+    const Vec3d pos = cam.center() + to_world * dir_cam * distance;
+    const double scale = 6 * distance / cam.fx;  // about 12 pixels across
+    switch (p) {
+        case ModelParam::Xyz:
+            return {float(pos.x), float(pos.y), float(pos.z)};
+        case ModelParam::Rotation: {
+            // w x y z (quaternion_from_rotation's order); its normal is the camera's axis.
+            const Vec4<double> q = quaternion_from_rotation(to_world);
+            return {float(q[0]), float(q[1]), float(q[2]), float(q[3])};
+        }
+        case ModelParam::Scaling:
+            return {float(std::log(scale)), float(std::log(scale))};
+        case ModelParam::Opacity:
+            return {inverse_sigmoid(0.9f)};
+        default:
+            return std::vector<float>(std::size_t(SurfelModel::width(p)), 0.1f);
+    }
+}
+
+std::size_t surfels_after_a_sweep(double share, Vec3f& painter) {
+    TrainConfig c = trainer_test::shrunk_config();
+    c.empty_space_prune_share = share;
+    c.prune_until_end = false;
+    Trainer t = trainer_test::make_trainer(c);
+    // Plant the painter into the starting surfels, then run the iteration of a sweep (after densification, a
+    // multiple of the opacity-reset rhythm, in the shadowed stage).
+    const TrainView& view = t.views().front();
+    const double distance = 0.5 * t.state().scene_extent;
+    std::vector<std::vector<float>> raw(kModelParamCount);
+    for (ModelParam p : kAllModelParams) {
+        raw[int(p)] = t.state().model.param(p);
+        const std::vector<float> row = painter_row(view, p, distance);
+        raw[int(p)].insert(raw[int(p)].end(), row.begin(), row.end());
+    }
+    const std::vector<float>& xyz = raw[int(ModelParam::Xyz)];
+    painter = {xyz[xyz.size() - 3], xyz[xyz.size() - 2], xyz[xyz.size() - 1]};
+    t.state().model =
+        GaussianModel::from_raw(std::move(raw), t.state().scene_extent, model_learning_rates(c));
+    t.state().iteration = 2 * c.opacity_reset_interval - 1;
+    const StepReport r = t.step();
+    EXPECT_EQ(r.empty_space_swept, share > 0);
+    // The step moved it a little (without the prune, Adam steps the positions).
+    const auto& p = t.state().model.param(ModelParam::Xyz);
+    const double near = 0.01 * t.state().scene_extent;
+    for (std::size_t i = 0; i < t.state().model.size(); ++i)
+        if (length(Vec3f{p[3 * i], p[3 * i + 1], p[3 * i + 2]} - painter) < near) return i;
+    return std::size_t(-1);
+}
+
+TEST(EmptySpacePrune, TrainingRemovesASurfelPlantedInTheSky) {
+    const TrainConfig c = trainer_test::shrunk_config();
+    ASSERT_GE(2 * c.opacity_reset_interval, c.densify_until);
+    ASSERT_GT(2 * c.opacity_reset_interval, c.start_shadowed);
+    ASSERT_FALSE(trainer_test::tiny_scene().views.front().sky.empty());
+    Vec3f painter;
+    EXPECT_NE(surfels_after_a_sweep(0.0, painter), std::size_t(-1)) << "without the prune the painter stays";
+    EXPECT_EQ(surfels_after_a_sweep(0.5, painter), std::size_t(-1)) << "the painter survived the sweep";
+}
+
+}  // namespace
+}  // namespace lumigauss
