@@ -165,6 +165,9 @@ TEST(GroundBackdrop, TrainingDrawsTheGroundOfItsCurrentSurfels) {
     EXPECT_GT(expected.x, 0.0f);
     EXPECT_EQ(h.ground_albedo.x, expected.x);
     EXPECT_EQ(h.ground_albedo.y, expected.y);
+    // With object masks the outside of the object is empty space: no ground.
+    c.mask_mode = "object";
+    EXPECT_EQ(trainer_test::make_trainer(c).sky_horizon().ground_albedo.x, 0.0f);
 }
 
 }  // namespace

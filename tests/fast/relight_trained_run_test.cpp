@@ -118,6 +118,12 @@ TEST(RelightTrainedRun, SkyHorizonIsTheTrainingCamerasMeanUpWithTheConfigAngles)
     const Vec3f expected = ground_albedo(grounded.model, grounded.sky_horizon.up);
     EXPECT_EQ(grounded.sky_horizon.ground_albedo.x, expected.x);
     EXPECT_EQ(grounded.sky_horizon.ground_albedo.z, expected.z);
+    {
+        std::ofstream c(run_paths(dir).config);
+        c << "{\"sky_background\": true, \"sky_horizon_start\": 3, \"sky_horizon_fade\": 5, "
+             "\"ground_backdrop\": true, \"mask_mode\": \"object\"}\n";
+    }
+    EXPECT_EQ(load_trained_run(dir).sky_horizon.ground_albedo.x, 0.0f);  // an object's outside is empty
     // A run trained without a fade has no horizon.
     {
         std::ofstream c(run_paths(dir).config);

@@ -128,8 +128,10 @@ TrainedRun load_trained_run(const std::string& dir) {
         if (c.is_object() && c.contains("sky_background") && c["sky_background"].is_boolean())
             run.sky_background = c["sky_background"].get<bool>();
         run.sky_horizon = recorded_sky_horizon(c, run.photos_up);
+        const bool object_masks = c.is_object() && c.contains("mask_mode") && c["mask_mode"].is_string() &&
+                                  c["mask_mode"] == "object";
         if (c.is_object() && c.contains("ground_backdrop") && c["ground_backdrop"].is_boolean() &&
-            c["ground_backdrop"].get<bool>() && run.sky_horizon.fade_degrees > 0)
+            c["ground_backdrop"].get<bool>() && !object_masks && run.sky_horizon.fade_degrees > 0)
             run.sky_horizon.ground_albedo = ground_albedo(run.model, run.sky_horizon.up);
     }
     return run;

@@ -95,7 +95,8 @@ struct TrainConfig {
     double sky_horizon_fade = 0.0;
     // Where the sky has faded below the horizon, the ground is drawn instead of black: the median albedo
     // of the surfels facing up (model/ground_albedo.h) lit by the photo's light. Holes in the near ground
-    // of a new viewpoint then look like ground.
+    // of a new viewpoint then look like ground. Not with object masks (mask_mode "object"), whose outside is
+    // empty space.
     bool ground_backdrop = false;
     // Where sky masks exist: alpha pushed to 0 on sky pixels (mean alpha over the sky mask eroded by
     // sky_mask_erosion pixels), the environment supervised by the sky pixels it must reproduce (L1 plus

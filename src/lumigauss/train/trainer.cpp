@@ -320,7 +320,9 @@ void Trainer::prepare_view_masks() {
 SkyHorizon Trainer::sky_horizon() const {
     const TrainConfig& c = state_.config;
     SkyHorizon horizon{up_, float(c.sky_horizon_start), float(c.sky_horizon_fade)};
-    if (c.ground_backdrop) horizon.ground_albedo = ground_albedo(state_.model, up_);
+    // An object mask's outside is empty space, the ground included.
+    if (c.ground_backdrop && c.mask_mode != "object")
+        horizon.ground_albedo = ground_albedo(state_.model, up_);
     return horizon;
 }
 
