@@ -1,7 +1,5 @@
 #include "lumigauss/model/trained_run.h"
 
-#include "lumigauss/model/ground_albedo.h"
-
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
@@ -10,6 +8,7 @@
 
 #include "lumigauss/cameras/up_axis.h"
 #include "lumigauss/io/text_file.h"
+#include "lumigauss/model/ground_albedo.h"
 #include "lumigauss/model/relightable_ply.h"
 #include "lumigauss/model/scene_record.h"
 #include "lumigauss/util/error.h"
