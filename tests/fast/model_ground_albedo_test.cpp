@@ -61,6 +61,10 @@ TEST(GroundAlbedo, WeightedMedianOfTheSurfelsFacingUp) {
         s.push_back({{1, 0, 0}, 3.0f, 1.0f, {1.0f, 1.0f, 1.0f}});
     const Vec3f a = ground_albedo(model_of(s), up);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], s[0].albedo[c], 2.0 / 1024) << c;
+    // A diverged surfel (NaN albedo) is left out, not binned.
+    std::vector<TestSurfel> with_nan = s;
+    with_nan.push_back({{0, 0, 1}, 9.0f, 1.0f, {std::nanf(""), 0.5f, 0.5f}});
+    EXPECT_EQ(ground_albedo(model_of(with_nan), up).x, a.x);
     // Two ground materials: the median moves to the one that covers more (opacity x area).
     s.push_back({{0, 0, 1}, 2.5f, 0.9f, {0.2f, 0.3f, 0.2f}});
     const Vec3f b = ground_albedo(model_of(s), up);

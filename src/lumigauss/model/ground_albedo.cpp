@@ -53,8 +53,10 @@ Vec3f ground_albedo(const SurfelModel& model, Vec3f up) {
         if (!(std::abs(dot(model.normal(i), up)) >= facing)) continue;
         const double weight =
             double(sigmoid(opacities[i])) * std::exp(double(scales[2 * i]) + double(scales[2 * i + 1]));
-        if (!(weight > 0) || !std::isfinite(weight)) continue;
         const Vec3f albedo = albedo_activation(model.raw_albedo(i));
+        // A NaN albedo (a diverged surfel, which the training's finite check reports) has no bin.
+        if (!(weight > 0) || !std::isfinite(weight) || !std::isfinite(albedo.x + albedo.y + albedo.z))
+            continue;
         for (int c = 0; c < 3; ++c) channels[std::size_t(c)].add(albedo[c], weight);
         total += weight;
     }

@@ -621,7 +621,7 @@ void Trainer::post_densification_prune(std::int64_t it, StepReport& report) {
     times_.densify += seconds_since(t0);
 }
 
-std::vector<float> Trainer::empty_pixels(int v) {
+std::vector<float> Trainer::empty_pixels(int v, const SkyHorizon& horizon) {
     const TrainConfig& c = state_.config;
     const ViewMasks& masks = masks_[std::size_t(v)];
     if (!masks.empty_unshrunk.empty()) return masks.empty_unshrunk;
@@ -634,7 +634,7 @@ std::vector<float> Trainer::empty_pixels(int v) {
     Sh4Coeffs<float> sky_residual{};
     if (residual) sky_residual = state_.sky_residuals.get(v);
     s.rays = pixel_ray_directions(view.camera);
-    sky_pixels(s.rays, environment(v), residual ? &sky_residual : nullptr, s.sky, sky_horizon());
+    sky_pixels(s.rays, environment(v), residual ? &sky_residual : nullptr, s.sky, horizon);
     return background_match_mask(view.rgb.pixels, s.sky.colour, masks.photometric, s.rays, up_,
                                  view.rgb.width, view.rgb.height, c.background_match_tolerance);
 }
@@ -647,8 +647,9 @@ std::size_t Trainer::prune_empty_space_painters() {
     std::vector<float> constrained;
     bool any_empty = false;
     model.activated(geometry);
+    const SkyHorizon horizon = sky_horizon();  // once: its ground albedo is a pass over every surfel
     for (int v = 0; v < int(views_.size()); ++v) {
-        const std::vector<float> empty = empty_pixels(v);
+        const std::vector<float> empty = empty_pixels(v, horizon);
         any_empty = any_empty || !empty.empty();
         // The pixels the photo constrains: its photometric mask, and the ones that must stay empty (an
         // object mask's outside is outside the photometric mask).

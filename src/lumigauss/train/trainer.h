@@ -158,8 +158,8 @@ class Trainer {
     std::size_t prune_empty_space_painters();
     // The pixels of training photo `view` that must stay empty: its sky or an object's outside, or
     // without masks (with a sky background and lambda_background_alpha) the pixels whose sky the photo
-    // already shows under its current light; empty when the photo has none.
-    std::vector<float> empty_pixels(int view);
+    // already shows under its current light (the sky drawn with `horizon`); empty when the photo has none.
+    std::vector<float> empty_pixels(int view, const SkyHorizon& horizon);
     void check_finite(std::int64_t iteration, const StepReport& report) const;
     void optimizer_step(std::int64_t iteration, Stage stage);
 
