@@ -140,6 +140,7 @@ std::vector<MemberChange> every_member() {
         {"densify_near_fraction", [](TrainConfig& c) { c.densify_near_fraction = 0.37; }},
         {"lambda_opacity", [](TrainConfig& c) { c.lambda_opacity = 0.01; }},
         {"empty_space_prune_share", [](TrainConfig& c) { c.empty_space_prune_share = 0.6; }},
+        {"min_contribution_pixels", [](TrainConfig& c) { c.min_contribution_pixels = 2.5; }},
         {"ground_backdrop", [](TrainConfig& c) { c.ground_backdrop = true; }},
         {"checkpoint_interval", [](TrainConfig& c) { c.checkpoint_interval = 0; }},
         {"log_interval", [](TrainConfig& c) { c.log_interval = 1; }},
@@ -238,11 +239,20 @@ TEST(TrainConfigPreset, PaperFastShrinksTheScheduleOnly) {
 
 // The default presets are the paper's (and paper-fast's) plus the improvements of issue #25, each a key.
 TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
-    const std::set<std::string> improvements = {
-        "init_normals_from_points", "sky_background",   "lambda_sky_alpha",      "sky_free_regularizers",
-        "lambda_background_alpha",  "prune_until_end",  "densify_near_fraction", "downscale",
-        "sky_horizon_start",        "sky_horizon_fade", "ground_seeds",          "empty_space_prune_share",
-        "ground_backdrop"};
+    const std::set<std::string> improvements = {"init_normals_from_points",
+                                                "sky_background",
+                                                "lambda_sky_alpha",
+                                                "sky_free_regularizers",
+                                                "lambda_background_alpha",
+                                                "prune_until_end",
+                                                "densify_near_fraction",
+                                                "downscale",
+                                                "sky_horizon_start",
+                                                "sky_horizon_fade",
+                                                "ground_seeds",
+                                                "empty_space_prune_share",
+                                                "ground_backdrop",
+                                                "min_contribution_pixels"};
     for (const auto& [improved, base] : {std::pair{"default", "paper"}, std::pair{"fast", "paper-fast"}}) {
         SCOPED_TRACE(improved);
         const Json a = Json::parse(train_config_to_json(train_preset(improved)));
@@ -262,6 +272,7 @@ TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
     EXPECT_EQ(paper.lambda_background_alpha, 0.0);
     EXPECT_EQ(paper.sky_horizon_fade, 0.0);
     EXPECT_EQ(paper.empty_space_prune_share, 0.0);
+    EXPECT_EQ(paper.min_contribution_pixels, 0.0);
     EXPECT_FALSE(paper.ground_backdrop);
     EXPECT_FALSE(paper.ground_seeds);
 }
@@ -287,7 +298,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 68, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 69, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;
@@ -655,6 +666,8 @@ TEST(TrainConfigValidate, RejectsEachBadValueNamingTheKey) {
         {"sky_horizon_fade", [](TrainConfig& c) { c.sky_horizon_start = 60, c.sky_horizon_fade = 40; }},
         {"empty_space_prune_share", [](TrainConfig& c) { c.empty_space_prune_share = -0.1; }},
         {"empty_space_prune_share", [](TrainConfig& c) { c.empty_space_prune_share = 1.5; }},
+        {"min_contribution_pixels", [](TrainConfig& c) { c.min_contribution_pixels = -1; }},
+        {"min_contribution_pixels", [](TrainConfig& c) { c.min_contribution_pixels = 1e9; }},
     };
     for (const char* preset : {"paper", "fast"}) {
         for (const Case& c : cases) {

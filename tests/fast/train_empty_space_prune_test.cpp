@@ -2,10 +2,13 @@
 // alone would give the masked pixels, the decision keeps the surfels that mostly cover the scene, and a
 // training run removes a surfel planted in its photos' sky (issue #25: large faint surfels painting a sky
 // that the degree-2 environment draws badly survived to the end of training and hung as a veil in front of
-// novel views; eval's sky_mean_alpha measured it).
+// novel views; eval's sky_mean_alpha measured it). The same sweep removes the surfels that add less than a
+// few pixels to all the photos together (min_contribution_pixels), at the end of training: a surfel planted
+// where no photo looks.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <vector>
 
 #include "fast/trainer_test_util.h"
@@ -114,34 +117,43 @@ std::vector<float> painter_row(const TrainView& view, ModelParam p, double dista
     }
 }
 
-std::size_t surfels_after_a_sweep(double share, Vec3f& painter) {
-    TrainConfig c = trainer_test::shrunk_config();
-    c.empty_space_prune_share = share;
-    c.prune_until_end = false;
+using PlantedRow = std::function<std::vector<float>(const Trainer&, ModelParam)>;
+
+// Plants one surfel (`row` gives its parameters) into the starting surfels, runs iteration `iteration` (by
+// default one of a sweep: after densification, a multiple of the opacity-reset rhythm, in the shadowed
+// stage), and returns the planted surfel's index afterwards, or -1 when the step removed it.
+std::size_t planted_after_a_sweep(const TrainConfig& c, const PlantedRow& row, bool expect_sweep,
+                                  std::int64_t iteration = 0) {
     Trainer t = trainer_test::make_trainer(c);
-    // Plant the painter into the starting surfels, then run the iteration of a sweep (after densification, a
-    // multiple of the opacity-reset rhythm, in the shadowed stage).
-    const TrainView& view = t.views().front();
-    const double distance = 0.5 * t.state().scene_extent;
     std::vector<std::vector<float>> raw(kModelParamCount);
     for (ModelParam p : kAllModelParams) {
         raw[int(p)] = t.state().model.param(p);
-        const std::vector<float> row = painter_row(view, p, distance);
-        raw[int(p)].insert(raw[int(p)].end(), row.begin(), row.end());
+        const std::vector<float> planted = row(t, p);
+        raw[int(p)].insert(raw[int(p)].end(), planted.begin(), planted.end());
     }
     const std::vector<float>& xyz = raw[int(ModelParam::Xyz)];
-    painter = {xyz[xyz.size() - 3], xyz[xyz.size() - 2], xyz[xyz.size() - 1]};
+    const Vec3f planted{xyz[xyz.size() - 3], xyz[xyz.size() - 2], xyz[xyz.size() - 1]};
     t.state().model =
         GaussianModel::from_raw(std::move(raw), t.state().scene_extent, model_learning_rates(c));
-    t.state().iteration = 2 * c.opacity_reset_interval - 1;
+    t.state().iteration = (iteration > 0 ? iteration : 2 * c.opacity_reset_interval) - 1;
     const StepReport r = t.step();
-    EXPECT_EQ(r.empty_space_swept, share > 0);
+    EXPECT_EQ(r.empty_space_swept, expect_sweep);
     // The step moved it a little (without the prune, Adam steps the positions).
     const auto& p = t.state().model.param(ModelParam::Xyz);
     const double near = 0.01 * t.state().scene_extent;
     for (std::size_t i = 0; i < t.state().model.size(); ++i)
-        if (length(Vec3f{p[3 * i], p[3 * i + 1], p[3 * i + 2]} - painter) < near) return i;
+        if (length(Vec3f{p[3 * i], p[3 * i + 1], p[3 * i + 2]} - planted) < near) return i;
     return std::size_t(-1);
+}
+
+std::size_t painter_after_a_sweep(double share) {
+    TrainConfig c = trainer_test::shrunk_config();
+    c.empty_space_prune_share = share;
+    c.prune_until_end = false;
+    const PlantedRow painter = [](const Trainer& t, ModelParam p) {
+        return painter_row(t.views().front(), p, 0.5 * t.state().scene_extent);
+    };
+    return planted_after_a_sweep(c, painter, share > 0);
 }
 
 TEST(EmptySpacePrune, TrainingRemovesASurfelPlantedInTheSky) {
@@ -149,9 +161,78 @@ TEST(EmptySpacePrune, TrainingRemovesASurfelPlantedInTheSky) {
     ASSERT_GE(2 * c.opacity_reset_interval, c.densify_until);
     ASSERT_GT(2 * c.opacity_reset_interval, c.start_shadowed);
     ASSERT_FALSE(trainer_test::tiny_scene().views.front().sky.empty());
-    Vec3f painter;
-    EXPECT_NE(surfels_after_a_sweep(0.0, painter), std::size_t(-1)) << "without the prune the painter stays";
-    EXPECT_EQ(surfels_after_a_sweep(0.5, painter), std::size_t(-1)) << "the painter survived the sweep";
+    EXPECT_NE(painter_after_a_sweep(0.0), std::size_t(-1)) << "without the prune the painter stays";
+    EXPECT_EQ(painter_after_a_sweep(0.5), std::size_t(-1)) << "the painter survived the sweep";
+}
+
+TEST(EmptySpacePrune, LowContributionRemovesTheSurfelsBelowThePixelCount) {
+    EmptySpaceWeights w;
+    w.constrained = {10, 3.9, 0, 4, 1};
+    w.empty = {0, 0, 0, 0, 0};
+    std::vector<std::uint8_t> keep = {1, 1, 1, 1, 0};  // the last already removed as a painter
+    EXPECT_EQ(remove_low_contribution(w, 4.0, keep), 2u);
+    EXPECT_EQ(keep, (std::vector<std::uint8_t>{1, 0, 0, 1, 0}));
+    std::vector<std::uint8_t> short_flags(2, 1);
+    EXPECT_THROW(remove_low_contribution(w, 4.0, short_flags), Error);
+}
+
+// A small opaque surfel far from the scene, where no training photo looks.
+std::vector<float> unseen_row(const Trainer& t, ModelParam p) {
+    const double extent = t.state().scene_extent;
+    Vec3d centre{0, 0, 0};
+    for (const TrainView& v : t.views())
+        centre = centre + v.camera.center() * (1.0 / double(t.views().size()));
+    const auto seen_by_any = [&](Vec3d x) {
+        for (const TrainView& v : t.views()) {
+            const Vec3d c = v.camera.world_to_camera(x);
+            if (c.z <= 0) continue;
+            const double u = v.camera.fx * c.x / c.z + v.camera.cx, w = v.camera.fy * c.y / c.z + v.camera.cy;
+            if (u > -v.camera.width && u < 2.0 * v.camera.width && w > -v.camera.height &&
+                w < 2.0 * v.camera.height)
+                return true;
+        }
+        return false;
+    };
+    Vec3d pos = centre;
+    for (const Vec3d dir :
+         {Vec3d{0, 0, -1}, Vec3d{0, 0, 1}, Vec3d{1, 0, 0}, Vec3d{-1, 0, 0}, Vec3d{0, 1, 0}, Vec3d{0, -1, 0}})
+        if (!seen_by_any(centre + dir * (20 * extent))) {
+            pos = centre + dir * (20 * extent);
+            break;
+        }
+    switch (p) {
+        case ModelParam::Xyz:
+            return {float(pos.x), float(pos.y), float(pos.z)};
+        case ModelParam::Rotation:
+            return {1, 0, 0, 0};
+        case ModelParam::Scaling:
+            return {float(std::log(0.01 * extent)), float(std::log(0.01 * extent))};
+        case ModelParam::Opacity:
+            return {inverse_sigmoid(0.9f)};
+        default:
+            return std::vector<float>(std::size_t(SurfelModel::width(p)), 0.1f);
+    }
+}
+
+TEST(EmptySpacePrune, TrainingRemovesASurfelNoPhotoSees) {
+    TrainConfig c = trainer_test::shrunk_config();
+    c.prune_until_end = false;
+    {  // the planted surfel is out of every photo (else the test proves nothing)
+        Trainer t = trainer_test::make_trainer(c);
+        const std::vector<float> xyz = unseen_row(t, ModelParam::Xyz);
+        Vec3d centre{0, 0, 0};
+        for (const TrainView& v : t.views())
+            centre = centre + v.camera.center() * (1.0 / double(t.views().size()));
+        ASSERT_GT(length(Vec3d{xyz[0], xyz[1], xyz[2]} - centre), 10 * t.state().scene_extent);
+    }
+    // The rule runs on the finished model: at the last iteration.
+    c.min_contribution_pixels = 0;
+    EXPECT_NE(planted_after_a_sweep(c, unseen_row, false, c.iterations), std::size_t(-1)) << "no rule, kept";
+    c.min_contribution_pixels = 4;
+    EXPECT_EQ(planted_after_a_sweep(c, unseen_row, true, c.iterations), std::size_t(-1)) << "it survived";
+    // Not at the sweeps before (it might still be moved into view).
+    c.empty_space_prune_share = 0.5;
+    EXPECT_NE(planted_after_a_sweep(c, unseen_row, true), std::size_t(-1)) << "removed before the end";
 }
 
 }  // namespace

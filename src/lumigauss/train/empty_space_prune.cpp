@@ -46,4 +46,15 @@ std::vector<std::uint8_t> keep_outside_empty_space(const EmptySpaceWeights& weig
     return keep;
 }
 
+std::size_t remove_low_contribution(const EmptySpaceWeights& weights, double min_pixels,
+                                    std::vector<std::uint8_t>& keep) {
+    if (keep.size() != weights.constrained.size())
+        throw Error("low-contribution prune: " + std::to_string(keep.size()) + " flags for " +
+                    std::to_string(weights.constrained.size()) + " surfels");
+    std::size_t removed = 0;
+    for (std::size_t i = 0; i < keep.size(); ++i)
+        if (keep[i] && weights.constrained[i] < min_pixels) keep[i] = 0, ++removed;
+    return removed;
+}
+
 }  // namespace lumigauss

@@ -45,7 +45,10 @@ std::string step_log_line(const StepReport& r, double elapsed_seconds, const Hel
     } else if (r.prune_ran) {
         j["pruned"] = r.densified.pruned;
     }
-    if (r.empty_space_swept) j["empty_space_pruned"] = r.empty_space_pruned;
+    if (r.empty_space_swept) {
+        j["empty_space_pruned"] = r.empty_space_pruned;
+        j["low_contribution_pruned"] = r.low_contribution_pruned;
+    }
     if (r.opacity_reset) j["opacity_reset"] = true;
     if (held_out.score) {
         j["held_out_psnr"] = held_out.score->psnr;

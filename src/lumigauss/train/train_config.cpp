@@ -107,6 +107,7 @@ constexpr std::array kFields = {
     LUMIGAUSS_FIELD(prune_until_end),
     LUMIGAUSS_FIELD(densify_near_fraction),
     LUMIGAUSS_FIELD(empty_space_prune_share),
+    LUMIGAUSS_FIELD(min_contribution_pixels),
     LUMIGAUSS_FIELD(lambda_opacity),
     LUMIGAUSS_FIELD(checkpoint_interval),
     LUMIGAUSS_FIELD(log_interval),
@@ -401,6 +402,7 @@ void add_improvements(TrainConfig& config) {
     config.prune_until_end = true;
     config.densify_near_fraction = 0.37;  // Pixel-GS's value; -5 deg of test-view normal error on plaza
     config.empty_space_prune_share = 0.5;
+    config.min_contribution_pixels = 4.0;
     config.downscale = 0;  // -r auto: large photos at most 1600 px (run_all.sh's -r 1 is off)
 }
 
@@ -608,6 +610,8 @@ void validate_train_config(const TrainConfig& c) {
     require(c.background_alpha_from >= 0, "background_alpha_from", c.background_alpha_from, "must be >= 0");
     require(c.empty_space_prune_share >= 0.0 && c.empty_space_prune_share <= 1.0, "empty_space_prune_share",
             c.empty_space_prune_share, "must be in [0, 1] (0: off)");
+    require(c.min_contribution_pixels >= 0.0 && c.min_contribution_pixels <= 1e6, "min_contribution_pixels",
+            c.min_contribution_pixels, "must be in [0, 1e6] pixels (0: off)");
     if (c.mask_mode != "transient" && c.mask_mode != "object")
         invalid("mask_mode", "'" + c.mask_mode + "'", "must be transient or object");
 

@@ -144,6 +144,11 @@ struct TrainConfig {
     // share of their blend weight in the training photos on pixels that must stay empty (sky mask, an
     // object's outside, or the background-explained pixels) are removed (train/empty_space_prune.h); 0 = off.
     double empty_space_prune_share = 0.0;
+    // At the last iteration's sweep: surfels whose blend weight summed over every training photo's
+    // constrained pixels is below this many pixels are removed (they add less colour to the whole training
+    // set than a few pixels: hidden inside or behind the surface, or out of every photo; LightGaussian's
+    // global significance); 0 = off.
+    double min_contribution_pixels = 0.0;
 
     // Run bookkeeping (not in the official code).
     std::int64_t checkpoint_interval = 1000;  // iterations between checkpoints; 0 = only at the end/interrupt

@@ -600,7 +600,8 @@ void Trainer::post_densification_prune(std::int64_t it, StepReport& report) {
     // The sweep over every photo costs about as many renders as there are photos: once per opacity-reset
     // rhythm, and at the end so that the saved model holds no painter.
     const bool sweep =
-        c.empty_space_prune_share > 0 && (it % c.opacity_reset_interval == 0 || it == c.iterations);
+        (c.empty_space_prune_share > 0 && it % c.opacity_reset_interval == 0) ||
+        ((c.empty_space_prune_share > 0 || c.min_contribution_pixels > 0) && it == c.iterations);
     if (!prune && !sweep) return;
     const auto t0 = Clock::now();
     if (prune) {
@@ -614,7 +615,7 @@ void Trainer::post_densification_prune(std::int64_t it, StepReport& report) {
         report.prune_ran = true;
     }
     if (sweep) {
-        report.empty_space_pruned = prune_empty_space_painters();
+        sweep_and_prune(it == c.iterations, report);
         report.empty_space_swept = true;
     }
     model.zero_grad();
@@ -639,7 +640,7 @@ std::vector<float> Trainer::empty_pixels(int v, const SkyHorizon& horizon) {
                                  view.rgb.width, view.rgb.height, c.background_match_tolerance);
 }
 
-std::size_t Trainer::prune_empty_space_painters() {
+void Trainer::sweep_and_prune(bool last, StepReport& report) {
     GaussianModel& model = state_.model;
     EmptySpaceWeights weights;
     weights.reset(model.size());
@@ -658,12 +659,18 @@ std::size_t Trainer::prune_empty_space_painters() {
         add_empty_space_weights(*scratch_->rasterizer, views_[std::size_t(v)].camera, geometry, constrained,
                                 empty, weights);
     }
-    if (!any_empty) return 0;
-    std::size_t removed = 0;
-    const std::vector<std::uint8_t> keep =
-        keep_outside_empty_space(weights, state_.config.empty_space_prune_share, removed);
-    if (removed > 0) model.keep_rows(keep);
-    return removed;
+    const TrainConfig& c = state_.config;
+    std::size_t painters = 0;
+    std::vector<std::uint8_t> keep(model.size(), 1);
+    if (any_empty && c.empty_space_prune_share > 0)
+        keep = keep_outside_empty_space(weights, c.empty_space_prune_share, painters);
+    // At the end only: a pass over the finished model (plaza, fast: 13 % fewer surfels, renders 19 % faster,
+    // test and training views within 0.03 dB). At every sweep, the model ended 19 % smaller, 0.07 dB lower.
+    const std::size_t low = last && c.min_contribution_pixels > 0
+                                ? remove_low_contribution(weights, c.min_contribution_pixels, keep)
+                                : 0;
+    if (painters + low > 0) model.keep_rows(keep);
+    report.empty_space_pruned = painters, report.low_contribution_pruned = low;
 }
 
 void Trainer::densify_step(std::int64_t it, Stage stage, StepReport& report) {
