@@ -598,7 +598,8 @@ void Trainer::post_densification_prune(std::int64_t it, StepReport& report) {
     // Beyond the paper: the prune goes on (nothing else removes a surfel once densification ends).
     const bool prune = c.prune_until_end && it % c.densify_interval == 0 && it < c.iterations;
     // The sweep over every photo costs about as many renders as there are photos: once per opacity-reset
-    // rhythm, and at the end so that the saved model holds no painter.
+    // rhythm, and at the end so that the saved model holds no painter (and, with min_contribution_pixels, no
+    // surfel that adds next to nothing to the photos).
     const bool sweep =
         (c.empty_space_prune_share > 0 && it % c.opacity_reset_interval == 0) ||
         ((c.empty_space_prune_share > 0 || c.min_contribution_pixels > 0) && it == c.iterations);
