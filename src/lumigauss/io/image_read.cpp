@@ -98,6 +98,12 @@ Image decode_with_stb(const std::string& path, Load load, float max_code) {
     return image;
 }
 
+// PNG's numbers: big-endian 32-bit.
+std::uint32_t png_uint32(const unsigned char* bytes) {
+    return (std::uint32_t(bytes[0]) << 24) | (std::uint32_t(bytes[1]) << 16) |
+           (std::uint32_t(bytes[2]) << 8) | std::uint32_t(bytes[3]);
+}
+
 // Width and height from a PNG's IHDR chunk (signature, length, "IHDR", two big-endian 32-bit numbers).
 std::optional<ImageInfo> png_header_size(const std::string& path) {
     unsigned char head[24] = {};
@@ -108,11 +114,7 @@ std::optional<ImageInfo> png_header_size(const std::string& path) {
     if (n != sizeof head || std::memcmp(head, "\x89PNG\r\n\x1a\n", 8) != 0 ||
         std::memcmp(head + 12, "IHDR", 4) != 0)
         return std::nullopt;
-    const auto big_endian = [&](int at) {
-        return (std::uint32_t(head[at]) << 24) | (std::uint32_t(head[at + 1]) << 16) |
-               (std::uint32_t(head[at + 2]) << 8) | std::uint32_t(head[at + 3]);
-    };
-    const std::uint32_t width = big_endian(16), height = big_endian(20);
+    const std::uint32_t width = png_uint32(head + 16), height = png_uint32(head + 20);
     if (width > 0x7fffffffu || height > 0x7fffffffu) return std::nullopt;
     return ImageInfo{int(width), int(height), 0};
 }
@@ -181,8 +183,7 @@ void require_png_chunks_in_file(const std::string& path) {
     std::uint64_t at = 8;
     while (at + 8 <= size) {
         if (std::fseek(f, long(at), SEEK_SET) != 0 || std::fread(head, 1, 8, f) != 8) break;
-        const std::uint64_t length = (std::uint64_t(head[0]) << 24) | (std::uint64_t(head[1]) << 16) |
-                                     (std::uint64_t(head[2]) << 8) | std::uint64_t(head[3]);
+        const std::uint64_t length = png_uint32(head);
         const std::string type(reinterpret_cast<const char*>(head + 4), 4);
         if (at + 12 + length > size)
             fail_in_file(path, "truncated or corrupt PNG: chunk '" + printable(type) + "' at byte " +
