@@ -186,6 +186,18 @@ TEST(TrainMlp, ForwardRejectsBadImageIndex) {
     EXPECT_THROW((void)mlp.forward(-1), Error);
 }
 
+// The readers' starting point: the shape of a drawn model, every value 0.
+TEST(TrainMlp, ZerosHasTheShapeOfADrawnModel) {
+    const LightingMlp drawn(5, 3), zeros = LightingMlp::zeros(5);
+    ASSERT_EQ(zeros.num_images(), 5);
+    for (MlpGroup g : kAllGroups) {
+        EXPECT_EQ(zeros.param(g).size(), drawn.param(g).size()) << mlp_group_name(g);
+        EXPECT_TRUE(
+            std::all_of(zeros.param(g).begin(), zeros.param(g).end(), [](float v) { return v == 0; }));
+    }
+    EXPECT_THROW((void)LightingMlp::zeros(-1), Error);
+}
+
 TEST(TrainMlp, SaveLoadRoundTrip) {
     lumigauss::testing::TempDir dir("TrainMlp_SaveLoad");
     const LightingMlp mlp(4, 21);

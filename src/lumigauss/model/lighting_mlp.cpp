@@ -78,6 +78,16 @@ BasicLightingMlp<T>::BasicLightingMlp(int num_images, std::uint32_t seed) : num_
 }
 
 template <typename T>
+BasicLightingMlp<T> BasicLightingMlp<T>::zeros(int num_images) {
+    if (num_images < 0) throw Error("lighting MLP: negative number of images");
+    BasicLightingMlp mlp;
+    mlp.num_images_ = num_images;
+    for (int gi = 0; gi < kMlpGroupCount; ++gi)
+        mlp.params_[gi].assign(group_size(static_cast<MlpGroup>(gi), num_images), T(0));
+    return mlp;
+}
+
+template <typename T>
 LightingForward<T> BasicLightingMlp<T>::forward(int image) const {
     if (image < 0 || image >= num_images_)
         throw Error("lighting MLP: image index " + std::to_string(image) + " out of range [0, " +
@@ -130,9 +140,8 @@ LightingMlp load_lighting_mlp(const std::string& path) {
 
     // The photo count sizes the embedding: check it against the file before allocating for it.
     std::size_t expected_floats = std::size_t(header[0]) * kEmbeddingDim;
-    const LightingMlp no_photos(0, 0);
     for (int gi = 0; gi < kMlpGroupCount; ++gi)
-        expected_floats += no_photos.param(static_cast<MlpGroup>(gi)).size();
+        expected_floats += LightingMlp::group_size(static_cast<MlpGroup>(gi), 0);
     const auto file_bytes = std::filesystem::file_size(path);
     const std::size_t header_bytes = sizeof magic + sizeof header;
     if (file_bytes != header_bytes + expected_floats * sizeof(float))
@@ -140,7 +149,7 @@ LightingMlp load_lighting_mlp(const std::string& path) {
                                std::to_string(header[0]) + " photos takes " +
                                std::to_string(header_bytes + expected_floats * sizeof(float)) +
                                " (truncated, or a wrong photo count)");
-    LightingMlp mlp(header[0], 0);
+    LightingMlp mlp = LightingMlp::zeros(header[0]);
     for (int gi = 0; gi < kMlpGroupCount; ++gi) {
         auto& v = mlp.param(static_cast<MlpGroup>(gi));
         read_exact(in, path, v.data(), v.size() * sizeof(float));

@@ -68,6 +68,9 @@ class BasicLightingMlp {
     BasicLightingMlp() = default;
     // num_images rows in the embedding table (the official code fixes 1700 rows; we size it to the data).
     BasicLightingMlp(int num_images, std::uint32_t seed);
+    // All parameters 0, for readers that fill them in (drawing the initial weights is most of the cost of
+    // reading a small file).
+    static BasicLightingMlp zeros(int num_images);
 
     int num_images() const { return num_images_; }
 

@@ -225,7 +225,7 @@ TrainState load_checkpoint(const std::string& path) {
     const auto images = r.value<std::int32_t>("lighting model");
     if (images <= 0 || std::uint64_t(images) != names)
         fail_in_file(path, "corrupt checkpoint (lighting model and photo list disagree)");
-    s.lighting = LightingMlp(images, 0);
+    s.lighting = LightingMlp::zeros(images);
     s.lighting_adam = lighting_optimizer(s.config, images);
     for (int g = 0; g < kMlpGroupCount; ++g) {
         auto values = r.floats("lighting model");
