@@ -139,6 +139,8 @@ std::vector<MemberChange> every_member() {
         {"prune_until_end", [](TrainConfig& c) { c.prune_until_end = true; }},
         {"densify_near_fraction", [](TrainConfig& c) { c.densify_near_fraction = 0.37; }},
         {"lambda_opacity", [](TrainConfig& c) { c.lambda_opacity = 0.01; }},
+        {"lambda_scale_ratio", [](TrainConfig& c) { c.lambda_scale_ratio = 0.5; }},
+        {"max_scale_ratio", [](TrainConfig& c) { c.max_scale_ratio = 4.0; }},
         {"empty_space_prune_share", [](TrainConfig& c) { c.empty_space_prune_share = 0.6; }},
         {"min_contribution_pixels", [](TrainConfig& c) { c.min_contribution_pixels = 2.5; }},
         {"ground_backdrop", [](TrainConfig& c) { c.ground_backdrop = true; }},
@@ -298,7 +300,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 69, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 71, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;
@@ -668,6 +670,9 @@ TEST(TrainConfigValidate, RejectsEachBadValueNamingTheKey) {
         {"empty_space_prune_share", [](TrainConfig& c) { c.empty_space_prune_share = 1.5; }},
         {"min_contribution_pixels", [](TrainConfig& c) { c.min_contribution_pixels = -1; }},
         {"min_contribution_pixels", [](TrainConfig& c) { c.min_contribution_pixels = 1e9; }},
+        {"lambda_scale_ratio", [](TrainConfig& c) { c.lambda_scale_ratio = -0.1; }},
+        {"max_scale_ratio", [](TrainConfig& c) { c.max_scale_ratio = 0.5; }},
+        {"max_scale_ratio", [](TrainConfig& c) { c.max_scale_ratio = 1e7; }},
     };
     for (const char* preset : {"paper", "fast"}) {
         for (const Case& c : cases) {

@@ -109,6 +109,8 @@ constexpr std::array kFields = {
     LUMIGAUSS_FIELD(empty_space_prune_share),
     LUMIGAUSS_FIELD(min_contribution_pixels),
     LUMIGAUSS_FIELD(lambda_opacity),
+    LUMIGAUSS_FIELD(lambda_scale_ratio),
+    LUMIGAUSS_FIELD(max_scale_ratio),
     LUMIGAUSS_FIELD(checkpoint_interval),
     LUMIGAUSS_FIELD(log_interval),
     LUMIGAUSS_FIELD(held_out_interval),
@@ -588,7 +590,7 @@ void validate_train_config(const TrainConfig& c) {
     require(c.percent_dense > 0.0, "percent_dense", c.percent_dense, "must be > 0");
 
     // Beyond the paper.
-    const std::array<std::pair<std::string_view, double>, 8> more_weights = {{
+    const std::array<std::pair<std::string_view, double>, 9> more_weights = {{
         {"lambda_sky_residual", c.lambda_sky_residual},
         {"lr_sky_residual", c.lr_sky_residual},
         {"lighting_init_radiance", c.lighting_init_radiance},
@@ -597,6 +599,7 @@ void validate_train_config(const TrainConfig& c) {
         {"lambda_background_alpha", c.lambda_background_alpha},
         {"densify_near_fraction", c.densify_near_fraction},
         {"lambda_opacity", c.lambda_opacity},
+        {"lambda_scale_ratio", c.lambda_scale_ratio},
     }};
     for (const auto& [key, value] : more_weights) require(value >= 0.0, key, value, "must be >= 0");
     require(c.sky_mask_erosion >= 0 && c.sky_mask_erosion <= 16, "sky_mask_erosion", c.sky_mask_erosion,
@@ -612,6 +615,8 @@ void validate_train_config(const TrainConfig& c) {
             c.empty_space_prune_share, "must be in [0, 1] (0: off)");
     require(c.min_contribution_pixels >= 0.0 && c.min_contribution_pixels <= 1e6, "min_contribution_pixels",
             c.min_contribution_pixels, "must be in [0, 1e6] pixels (0: off)");
+    require(c.max_scale_ratio >= 1.0 && c.max_scale_ratio <= 1e6, "max_scale_ratio", c.max_scale_ratio,
+            "must be in [1, 1e6]");
     if (c.mask_mode != "transient" && c.mask_mode != "object")
         invalid("mask_mode", "'" + c.mask_mode + "'", "must be transient or object");
 

@@ -140,6 +140,10 @@ struct TrainConfig {
     bool prune_until_end = false;
     double densify_near_fraction = 0.0;
     double lambda_opacity = 0.0;
+    // A pull on surfels whose tangent scales differ by more than max_scale_ratio (needles; see
+    // train/scale_ratio_penalty.h); 0 = off.
+    double lambda_scale_ratio = 0.0;
+    double max_scale_ratio = 10.0;
     // After densification, once per opacity_reset_interval and at the end: surfels with more than this
     // share of their blend weight in the training photos on pixels that must stay empty (sky mask, an
     // object's outside, or the background-explained pixels) are removed (train/empty_space_prune.h); 0 = off.

@@ -16,6 +16,7 @@
 #include "lumigauss/train/empty_space_prune.h"
 #include "lumigauss/train/image_losses.h"
 #include "lumigauss/train/physical_losses.h"
+#include "lumigauss/train/scale_ratio_penalty.h"
 #include "lumigauss/train/sky_losses.h"
 #include "lumigauss/train/view_shading_backward.h"
 #include "lumigauss/util/error.h"
@@ -533,6 +534,11 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
         const float g_each = n > 0 ? float(c.lambda_opacity / double(n)) : 0.0f;
         for (float& v : s.surfel_grads.opacities) v += g_each;
     }
+    if (c.lambda_scale_ratio > 0) {
+        report.scale_ratio = scale_ratio_penalty(s.batch.scales, c.max_scale_ratio, c.lambda_scale_ratio,
+                                                 s.surfel_grads.scales);
+        report.total += c.lambda_scale_ratio * report.scale_ratio;
+    }
     model.accumulate_grads_from_activated(sg);
     const ShCoeffs<float> g_shading = shade_surfels_backward(model, env, mode, s.normals, sg.colors);
     for (int k = 0; k < kShCount; ++k) g_env.c[k] = g_env.c[k] + g_shading.c[k];
@@ -581,6 +587,7 @@ void Trainer::check_finite(std::int64_t it, const StepReport& r) const {
                                                     {"loss sky colour", r.sky_colour},
                                                     {"loss background alpha", r.background_alpha},
                                                     {"loss opacity", r.opacity},
+                                                    {"loss scale ratio", r.scale_ratio},
                                                     {"loss sky residual", r.sky_residual}};
     for (const auto& [name, value] : terms)
         if (!std::isfinite(value)) throw NonFiniteError(it, name);
