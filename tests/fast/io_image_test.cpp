@@ -177,6 +177,33 @@ TEST(IoImage, CutRadianceHdrIsRefused) {
     expect_error([&] { read_image(tmp / "headless.hdr"); }, {"headless.hdr"});
 }
 
+// stb_image read the pixels a cut TGA lacks as zeros (fuzz_image: a 4 KB file declaring 12336 x 2608 gave
+// 515 MB of floats). Uncompressed and run-length encoded TGAs must hold the pixels they declare.
+TEST(IoImage, CutTgaIsRefused) {
+    TempDir tmp;
+    std::vector<unsigned char> rgb(16 * 8 * 3);
+    for (std::size_t i = 0; i < rgb.size(); ++i) rgb[i] = static_cast<unsigned char>(i * 5);
+    for (const int rle : {0, 1}) {
+        stbi_write_tga_with_rle = rle;
+        const std::string full = tmp / "full.tga";
+        ASSERT_TRUE(stbi_write_tga(full.c_str(), 16, 8, 3, rgb.data()));
+        const Image back = read_image(full);
+        EXPECT_EQ(back.width, 16);
+        EXPECT_EQ(back.height, 8);
+        const std::string bytes = test::read_text(full);
+        if (!rle) {  // cut in the pixels
+            test::write_text(tmp / "cut.tga", bytes.substr(0, 18 + 16 * 8 * 3 / 2));
+            expect_error([&] { read_image(tmp / "cut.tga"); }, {"cut.tga", "truncated"});
+        }
+        // The header alone, declaring 12336 x 2608 (the fuzzer's input had 4 KB of it).
+        std::string header = bytes.substr(0, 18);
+        header[12] = char(0x30), header[13] = char(0x30), header[14] = char(0x30), header[15] = char(0x0a);
+        test::write_text(tmp / "huge.tga", header + std::string(4096, '\x01'));
+        expect_error([&] { read_image(tmp / "huge.tga"); }, {"huge.tga", "truncated"});
+    }
+    stbi_write_tga_with_rle = 1;
+}
+
 // A 379 KB PNG declaring 20000 x 20000 pixels took 1.9 GB before failing without naming the file. The
 // declared size is now checked against kMaxImagePixels before anything is decoded.
 TEST(IoImage, DeclaredSizeOverTheLimitIsRefused) {
