@@ -129,6 +129,14 @@ void require_pixel_limit(const std::string& path, const ImageInfo& info) {
                                std::to_string(kMaxImagePixels) + " (16384 x 8192)");
 }
 
+// The file's size in bytes; an Error naming it if it cannot be read.
+std::uint64_t file_bytes(const std::string& path) {
+    std::error_code ec;
+    const std::uint64_t size = std::filesystem::file_size(path, ec);
+    if (ec) fail_in_file(path, "cannot read the file size (" + ec.message() + ")");
+    return size;
+}
+
 // No image format decodes to more samples than this per byte of file: deflate (PNG, EXR ZIP) expands at most
 // 1032:1, a 1-bit palette PNG packs 8 pixels per byte and expands to 4 channels, and run-length and JPEG
 // entropy codes stay below that. A file declaring more is lying about its size, and is refused before stb or
@@ -136,9 +144,7 @@ void require_pixel_limit(const std::string& path, const ImageInfo& info) {
 constexpr double kMaxSamplesPerFileByte = 32768;
 
 void require_plausible_size(const std::string& path, const ImageInfo& info) {
-    std::error_code ec;
-    const auto bytes = std::filesystem::file_size(path, ec);
-    if (ec) fail_in_file(path, "cannot read the file size (" + ec.message() + ")");
+    const std::uint64_t bytes = file_bytes(path);
     const double samples = double(info.width) * double(info.height) * double(std::max(info.channels, 1));
     if (samples > kMaxSamplesPerFileByte * double(bytes))
         fail_in_file(path, "the image declares " + std::to_string(info.width) + " x " +
@@ -177,9 +183,7 @@ void require_png_chunks_in_file(const std::string& path) {
     unsigned char head[8];
     if (std::fread(head, 1, 8, f) != 8 || std::memcmp(head, "\x89PNG\r\n\x1a\n", 8) != 0)
         return;  // not a PNG
-    std::error_code ec;
-    const std::uint64_t size = std::filesystem::file_size(path, ec);
-    if (ec) fail_in_file(path, "cannot read the file size (" + ec.message() + ")");
+    const std::uint64_t size = file_bytes(path);
     std::uint64_t at = 8;
     while (at + 8 <= size) {
         if (std::fseek(f, long(at), SEEK_SET) != 0 || std::fread(head, 1, 8, f) != 8) break;
@@ -207,9 +211,7 @@ void require_complete_tga(const std::string& path, const ImageInfo& info) {
     const int type = h[2], width = h[12] | (h[13] << 8), height = h[14] | (h[15] << 8);
     const bool uncompressed = type >= 1 && type <= 3, run_length = type >= 9 && type <= 11;
     if (!(uncompressed || run_length) || width != info.width || height != info.height) return;  // not a TGA
-    std::error_code ec;
-    const std::uint64_t size = std::filesystem::file_size(path, ec);
-    if (ec) fail_in_file(path, "cannot read the file size (" + ec.message() + ")");
+    const std::uint64_t size = file_bytes(path);
     const std::uint64_t pixels = std::uint64_t(width) * std::uint64_t(height);
     const std::uint64_t pixel_bytes = std::max(1, (h[16] + 7) / 8);
     const std::uint64_t palette = h[1] == 1 ? std::uint64_t(h[5] | (h[6] << 8)) * ((h[7] + 7) / 8) : 0;
