@@ -143,6 +143,7 @@ std::vector<MemberChange> every_member() {
         {"max_scale_ratio", [](TrainConfig& c) { c.max_scale_ratio = 4.0; }},
         {"empty_space_prune_share", [](TrainConfig& c) { c.empty_space_prune_share = 0.6; }},
         {"min_contribution_pixels", [](TrainConfig& c) { c.min_contribution_pixels = 2.5; }},
+        {"min_ground_views", [](TrainConfig& c) { c.min_ground_views = 3; }},
         {"ground_backdrop", [](TrainConfig& c) { c.ground_backdrop = true; }},
         {"checkpoint_interval", [](TrainConfig& c) { c.checkpoint_interval = 0; }},
         {"log_interval", [](TrainConfig& c) { c.log_interval = 1; }},
@@ -275,6 +276,7 @@ TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
     EXPECT_EQ(paper.sky_horizon_fade, 0.0);
     EXPECT_EQ(paper.empty_space_prune_share, 0.0);
     EXPECT_EQ(paper.min_contribution_pixels, 0.0);
+    EXPECT_EQ(paper.min_ground_views, 0);
     EXPECT_FALSE(paper.ground_backdrop);
     EXPECT_FALSE(paper.ground_seeds);
 }
@@ -300,7 +302,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 71, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 72, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;
@@ -670,6 +672,8 @@ TEST(TrainConfigValidate, RejectsEachBadValueNamingTheKey) {
         {"empty_space_prune_share", [](TrainConfig& c) { c.empty_space_prune_share = 1.5; }},
         {"min_contribution_pixels", [](TrainConfig& c) { c.min_contribution_pixels = -1; }},
         {"min_contribution_pixels", [](TrainConfig& c) { c.min_contribution_pixels = 1e9; }},
+        {"min_ground_views", [](TrainConfig& c) { c.min_ground_views = -1; }},
+        {"min_ground_views", [](TrainConfig& c) { c.min_ground_views = 1001; }},
         {"lambda_scale_ratio", [](TrainConfig& c) { c.lambda_scale_ratio = -0.1; }},
         {"max_scale_ratio", [](TrainConfig& c) { c.max_scale_ratio = 0.5; }},
         {"max_scale_ratio", [](TrainConfig& c) { c.max_scale_ratio = 1e7; }},

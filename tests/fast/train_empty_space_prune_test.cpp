@@ -4,7 +4,7 @@
 // that the degree-2 environment draws badly survived to the end of training and hung as a veil in front of
 // novel views; eval's sky_mean_alpha measured it). The same sweep removes the surfels that add less than a
 // few pixels to all the photos together (min_contribution_pixels), at the end of training: a surfel planted
-// where no photo looks.
+// where no photo looks; and those below the cameras that too few photos see (min_ground_views).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -59,6 +59,9 @@ TEST(EmptySpacePrune, WeightsAreEachSurfelsColourOverTheMaskedPixels) {
         for (std::size_t p = 0; p < pixels; ++p) c += alone[p] * constrained[p], e += alone[p] * empty[p];
         EXPECT_NEAR(w.constrained[i], 2 * c, 1e-4 * (1 + c)) << "surfel " << i;
         EXPECT_NEAR(w.empty[i], e, 1e-4 * (1 + e)) << "surfel " << i;
+        if (std::abs(c - kSeenPixels) > 1e-3) {  // both photos see it alike
+            EXPECT_EQ(w.photos_seeing[i], c >= kSeenPixels ? 2u : 0u) << "surfel " << i << ", weight " << c;
+        }
         seen += c > 1 ? 1 : 0;
         partly_empty += e > 0.1 && e < c ? 1 : 0;
     }
@@ -176,30 +179,45 @@ TEST(EmptySpacePrune, LowContributionRemovesTheSurfelsBelowThePixelCount) {
     EXPECT_THROW(remove_low_contribution(w, 4.0, short_flags), Error);
 }
 
-// A small opaque surfel far from the scene, where no training photo looks.
-std::vector<float> unseen_row(const Trainer& t, ModelParam p) {
-    const double extent = t.state().scene_extent;
+TEST(EmptySpacePrune, WeaklySeenGroundRemovesTheLowSurfelsFewPhotosSee) {
+    EmptySpaceWeights w;
+    w.reset(5);
+    w.photos_seeing = {0, 2, 3, 1, 0};
+    // Up is +y here; the cameras' feet at height 1.5.
+    const std::vector<float> centres = {0, 1, 0, 5, -2, 5, 0, 0, 0, 0, 2, 0, 9, 1.4f, 9};
+    std::vector<std::uint8_t> keep = {1, 1, 1, 1, 0};  // the last already removed
+    EXPECT_EQ(remove_weakly_seen_ground(w, centres, Vec3f{0, 1, 0}, 1.5, 3, keep), 2u);
+    // Low and seen by 0 or 2 photos: removed; seen by 3: kept; above the cameras: kept.
+    EXPECT_EQ(keep, (std::vector<std::uint8_t>{0, 0, 1, 1, 0}));
+    std::vector<std::uint8_t> short_flags(2, 1);
+    EXPECT_THROW(remove_weakly_seen_ground(w, centres, Vec3f{0, 1, 0}, 1.5, 3, short_flags), Error);
+    std::vector<std::uint8_t> all(5, 1);
+    EXPECT_EQ(remove_weakly_seen_ground(w, centres, Vec3f{0, 1, 0}, 1.5, 0, all), 0u) << "0 photos: none";
+}
+
+Vec3d mean_camera_centre(const Trainer& t) {
     Vec3d centre{0, 0, 0};
     for (const TrainView& v : t.views())
         centre = centre + v.camera.center() * (1.0 / double(t.views().size()));
-    const auto seen_by_any = [&](Vec3d x) {
-        for (const TrainView& v : t.views()) {
-            const Vec3d c = v.camera.world_to_camera(x);
-            if (c.z <= 0) continue;
-            const double u = v.camera.fx * c.x / c.z + v.camera.cx, w = v.camera.fy * c.y / c.z + v.camera.cy;
-            if (u > -v.camera.width && u < 2.0 * v.camera.width && w > -v.camera.height &&
-                w < 2.0 * v.camera.height)
-                return true;
-        }
-        return false;
-    };
-    Vec3d pos = centre;
-    for (const Vec3d dir :
-         {Vec3d{0, 0, -1}, Vec3d{0, 0, 1}, Vec3d{1, 0, 0}, Vec3d{-1, 0, 0}, Vec3d{0, 1, 0}, Vec3d{0, -1, 0}})
-        if (!seen_by_any(centre + dir * (20 * extent))) {
-            pos = centre + dir * (20 * extent);
-            break;
-        }
+    return centre;
+}
+
+// Whether x projects anywhere near a training photo's frame.
+bool seen_by_any(const Trainer& t, Vec3d x) {
+    for (const TrainView& v : t.views()) {
+        const Vec3d c = v.camera.world_to_camera(x);
+        if (c.z <= 0) continue;
+        const double u = v.camera.fx * c.x / c.z + v.camera.cx, w = v.camera.fy * c.y / c.z + v.camera.cy;
+        if (u > -v.camera.width && u < 2.0 * v.camera.width && w > -v.camera.height &&
+            w < 2.0 * v.camera.height)
+            return true;
+    }
+    return false;
+}
+
+// A small opaque surfel at `pos`, facing +z.
+std::vector<float> small_surfel_row(const Trainer& t, ModelParam p, Vec3d pos) {
+    const double extent = t.state().scene_extent;
     switch (p) {
         case ModelParam::Xyz:
             return {float(pos.x), float(pos.y), float(pos.z)};
@@ -212,6 +230,20 @@ std::vector<float> unseen_row(const Trainer& t, ModelParam p) {
         default:
             return std::vector<float>(std::size_t(SurfelModel::width(p)), 0.1f);
     }
+}
+
+// A small opaque surfel far from the scene, where no training photo looks.
+std::vector<float> unseen_row(const Trainer& t, ModelParam p) {
+    const double extent = t.state().scene_extent;
+    const Vec3d centre = mean_camera_centre(t);
+    Vec3d pos = centre;
+    for (const Vec3d dir :
+         {Vec3d{0, 0, -1}, Vec3d{0, 0, 1}, Vec3d{1, 0, 0}, Vec3d{-1, 0, 0}, Vec3d{0, 1, 0}, Vec3d{0, -1, 0}})
+        if (!seen_by_any(t, centre + dir * (20 * extent))) {
+            pos = centre + dir * (20 * extent);
+            break;
+        }
+    return small_surfel_row(t, p, pos);
 }
 
 TEST(EmptySpacePrune, TrainingRemovesASurfelNoPhotoSees) {
@@ -233,6 +265,36 @@ TEST(EmptySpacePrune, TrainingRemovesASurfelNoPhotoSees) {
     // Not at the sweeps before (it might still be moved into view).
     c.empty_space_prune_share = 0.5;
     EXPECT_NE(planted_after_a_sweep(c, unseen_row, true), std::size_t(-1)) << "removed before the end";
+}
+
+// A surfel no photo sees, 20 scene extents below (sign -1) or above (+1) the cameras' mean centre.
+std::vector<float> unseen_row_along_up(const Trainer& t, ModelParam p, double sign) {
+    const Vec3d up = t.sky_horizon().up.cast<double>();
+    return small_surfel_row(t, p, mean_camera_centre(t) + up * (sign * 20 * t.state().scene_extent));
+}
+
+TEST(EmptySpacePrune, TrainingRemovesTheUnseenSurfelsBelowTheCameras) {
+    TrainConfig c = trainer_test::shrunk_config();
+    c.prune_until_end = false;
+    {  // neither planted surfel is in a photo (else the test proves nothing)
+        Trainer t = trainer_test::make_trainer(c);
+        for (double sign : {-1.0, 1.0}) {
+            const std::vector<float> xyz = unseen_row_along_up(t, ModelParam::Xyz, sign);
+            ASSERT_FALSE(seen_by_any(t, Vec3d{xyz[0], xyz[1], xyz[2]}));
+        }
+    }
+    const PlantedRow below = [](const Trainer& t, ModelParam p) { return unseen_row_along_up(t, p, -1); };
+    const PlantedRow above = [](const Trainer& t, ModelParam p) { return unseen_row_along_up(t, p, 1); };
+    // On the finished model (the last iteration); the one above the cameras stays.
+    c.min_ground_views = 0;
+    EXPECT_NE(planted_after_a_sweep(c, below, c.min_contribution_pixels > 0, c.iterations), std::size_t(-1))
+        << "no rule, kept";
+    c.min_ground_views = 3;
+    EXPECT_EQ(planted_after_a_sweep(c, below, true, c.iterations), std::size_t(-1)) << "it survived";
+    EXPECT_NE(planted_after_a_sweep(c, above, true, c.iterations), std::size_t(-1)) << "removed above";
+    // Not before (right after densification, the surfels left grew back into the same ground).
+    c.empty_space_prune_share = 0.5;
+    EXPECT_NE(planted_after_a_sweep(c, below, true), std::size_t(-1)) << "removed before the end";
 }
 
 }  // namespace

@@ -32,6 +32,7 @@ void add_empty_space_weights(Rasterizer& rasterizer, const Camera& camera, Surfe
     for (std::size_t i = 0; i < geometry.size(); ++i) {
         weights.constrained[i] += double(sums.colors[2 * i]);
         weights.empty[i] += double(sums.colors[2 * i + 1]);
+        if (double(sums.colors[2 * i]) >= kSeenPixels) ++weights.photos_seeing[i];
     }
 }
 
@@ -54,6 +55,23 @@ std::size_t remove_low_contribution(const EmptySpaceWeights& weights, double min
     std::size_t removed = 0;
     for (std::size_t i = 0; i < keep.size(); ++i)
         if (keep[i] && weights.constrained[i] < min_pixels) keep[i] = 0, ++removed;
+    return removed;
+}
+
+std::size_t remove_weakly_seen_ground(const EmptySpaceWeights& weights, std::span<const float> centres,
+                                      Vec3f up, double max_height, int min_photos,
+                                      std::vector<std::uint8_t>& keep) {
+    const std::size_t n = weights.photos_seeing.size();
+    if (keep.size() != n || centres.size() != 3 * n)
+        throw Error("weakly-seen-ground prune: " + std::to_string(keep.size()) + " flags and " +
+                    std::to_string(centres.size() / 3) + " centres for " + std::to_string(n) + " surfels");
+    std::size_t removed = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3f c{centres[3 * i], centres[3 * i + 1], centres[3 * i + 2]};
+        if (keep[i] && double(dot(c, up)) < max_height &&
+            weights.photos_seeing[i] < std::uint32_t(min_photos))
+            keep[i] = 0, ++removed;
+    }
     return removed;
 }
 

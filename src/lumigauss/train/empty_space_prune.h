@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "lumigauss/io/camera.h"
+#include "lumigauss/math/vec.h"
 #include "lumigauss/render/raster_types.h"
 #include "lumigauss/render/rasterizer.h"
 
@@ -27,9 +28,16 @@ namespace lumigauss {
 // part of it on pixels that must stay empty.
 struct EmptySpaceWeights {
     std::vector<double> constrained, empty;
+    // How many of the photos added give the surfel at least kSeenPixels of weight on constrained pixels.
+    std::vector<std::uint32_t> photos_seeing;
 
-    void reset(std::size_t surfels) { constrained.assign(surfels, 0.0), empty.assign(surfels, 0.0); }
+    void reset(std::size_t surfels) {
+        constrained.assign(surfels, 0.0), empty.assign(surfels, 0.0), photos_seeing.assign(surfels, 0);
+    }
 };
+
+// The blend weight (pixels) from which a photo counts as seeing a surfel.
+inline constexpr double kSeenPixels = 1.0;
 
 // Adds one photo. `geometry` holds the surfels as rasterized (SurfelModel::activated; its colours are
 // overwritten); `constrained` and `empty` hold one weight per pixel of the camera's image (empty <=
@@ -48,5 +56,15 @@ std::vector<std::uint8_t> keep_outside_empty_space(const EmptySpaceWeights& weig
 // the surface, or outside every photo). Returns how many it removed.
 std::size_t remove_low_contribution(const EmptySpaceWeights& weights, double min_pixels,
                                     std::vector<std::uint8_t>& keep);
+
+// Sets keep[i] = 0 for the surfels still kept whose centre lies below `max_height` along `up` (unit; height
+// = dot(centre, up)) and that fewer than `min_photos` photos see (photos_seeing). A surface seen by one
+// photo can take any depth and tilt along that photo's rays and still match it; the ground around the
+// cameras is seen so (steeply by the nearest photo, at a grazing angle or not at all by the others), and from
+// a new viewpoint such surfels are streaks and slashes across it. `centres`: 3 floats per surfel. Returns
+// how many it removed.
+std::size_t remove_weakly_seen_ground(const EmptySpaceWeights& weights, std::span<const float> centres,
+                                      Vec3f up, double max_height, int min_photos,
+                                      std::vector<std::uint8_t>& keep);
 
 }  // namespace lumigauss

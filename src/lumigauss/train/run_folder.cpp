@@ -49,6 +49,7 @@ std::string step_log_line(const StepReport& r, double elapsed_seconds, const Hel
     if (r.empty_space_swept) {
         j["empty_space_pruned"] = r.empty_space_pruned;
         j["low_contribution_pruned"] = r.low_contribution_pruned;
+        j["weakly_seen_ground_pruned"] = r.weakly_seen_ground_pruned;
     }
     if (r.opacity_reset) j["opacity_reset"] = true;
     if (held_out.score) {

@@ -108,6 +108,7 @@ constexpr std::array kFields = {
     LUMIGAUSS_FIELD(densify_near_fraction),
     LUMIGAUSS_FIELD(empty_space_prune_share),
     LUMIGAUSS_FIELD(min_contribution_pixels),
+    LUMIGAUSS_FIELD(min_ground_views),
     LUMIGAUSS_FIELD(lambda_opacity),
     LUMIGAUSS_FIELD(lambda_scale_ratio),
     LUMIGAUSS_FIELD(max_scale_ratio),
@@ -615,6 +616,8 @@ void validate_train_config(const TrainConfig& c) {
             c.empty_space_prune_share, "must be in [0, 1] (0: off)");
     require(c.min_contribution_pixels >= 0.0 && c.min_contribution_pixels <= 1e6, "min_contribution_pixels",
             c.min_contribution_pixels, "must be in [0, 1e6] pixels (0: off)");
+    require(c.min_ground_views >= 0 && c.min_ground_views <= 1000, "min_ground_views", c.min_ground_views,
+            "must be in [0, 1000] photos (0: off)");
     require(c.max_scale_ratio >= 1.0 && c.max_scale_ratio <= 1e6, "max_scale_ratio", c.max_scale_ratio,
             "must be in [1, 1e6]");
     if (c.mask_mode != "transient" && c.mask_mode != "object")

@@ -153,6 +153,15 @@ struct TrainConfig {
     // set than a few pixels: hidden inside or behind the surface, or out of every photo; LightGaussian's
     // global significance); 0 = off.
     double min_contribution_pixels = 0.0;
+    // At the last iteration's sweep: surfels lower than the lowest training camera (along the photos' up)
+    // that fewer than this many training photos see with at least a pixel of blend weight are removed
+    // (train/empty_space_prune.h, remove_weakly_seen_ground); 0 = off. Seen by one or two photos, nothing
+    // triangulates a surfel's depth and tilt: on the ground around the cameras such surfels are the streaks
+    // of new views, and the ground backdrop draws the ground they leave. Off in every preset: it cleans
+    // plaza's new views (the default schedule's spikes on test_0001 gone, +0.16 dB) but costs the training
+    // photos the near ground they alone saw (their tile joints), and on the demo scenes the backdrop left
+    // in their place is a darker band (-0.16 dB on the temple; bench/RESULTS.md, session 32).
+    int min_ground_views = 0;
 
     // Run bookkeeping (not in the official code).
     std::int64_t checkpoint_interval = 1000;  // iterations between checkpoints; 0 = only at the end/interrupt

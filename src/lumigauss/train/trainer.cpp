@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "lumigauss/cameras/up_axis.h"
@@ -609,7 +610,8 @@ void Trainer::post_densification_prune(std::int64_t it, StepReport& report) {
     // surfel that adds next to nothing to the photos).
     const bool sweep =
         (c.empty_space_prune_share > 0 && it % c.opacity_reset_interval == 0) ||
-        ((c.empty_space_prune_share > 0 || c.min_contribution_pixels > 0) && it == c.iterations);
+        ((c.empty_space_prune_share > 0 || c.min_contribution_pixels > 0 || c.min_ground_views > 0) &&
+         it == c.iterations);
     if (!prune && !sweep) return;
     const auto t0 = Clock::now();
     if (prune) {
@@ -648,6 +650,12 @@ std::vector<float> Trainer::empty_pixels(int v, const SkyHorizon& horizon) {
                                  view.rgb.width, view.rgb.height, c.background_match_tolerance);
 }
 
+double Trainer::lowest_camera_height() const {
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const TrainView& v : views_) lowest = std::min(lowest, dot(v.camera.center(), up_.cast<double>()));
+    return lowest;
+}
+
 void Trainer::sweep_and_prune(bool last, StepReport& report) {
     GaussianModel& model = state_.model;
     EmptySpaceWeights weights;
@@ -677,8 +685,16 @@ void Trainer::sweep_and_prune(bool last, StepReport& report) {
     const std::size_t low = last && c.min_contribution_pixels > 0
                                 ? remove_low_contribution(weights, c.min_contribution_pixels, keep)
                                 : 0;
-    if (painters + low > 0) model.keep_rows(keep);
+    // At the end only, as the low-contribution rule: removed during training (plaza, fast: at every sweep
+    // from the end of densification on), the surfels left grew into the same ground and streaked it again.
+    const std::size_t ground =
+        last && c.min_ground_views > 0
+            ? remove_weakly_seen_ground(weights, model.param(ModelParam::Xyz), up_, lowest_camera_height(),
+                                        c.min_ground_views, keep)
+            : 0;
+    if (painters + low + ground > 0) model.keep_rows(keep);
     report.empty_space_pruned = painters, report.low_contribution_pruned = low;
+    report.weakly_seen_ground_pruned = ground;
 }
 
 void Trainer::densify_step(std::int64_t it, Stage stage, StepReport& report) {

@@ -72,9 +72,9 @@ struct StepReport {
     bool densify_ran = false, opacity_reset = false;
     bool prune_ran = false;  // the prune alone, after densification (prune_until_end)
     // Surfels removed for painting empty space (config empty_space_prune_share, train/empty_space_prune.h)
-    // and for adding too little to the photos (min_contribution_pixels); the sweep over the photos ran this
-    // iteration when empty_space_swept.
-    std::size_t empty_space_pruned = 0, low_contribution_pruned = 0;
+    // for adding too little to the photos (min_contribution_pixels), and for lying low where too few photos
+    // see them (min_ground_views); the sweep over the photos ran this iteration when empty_space_swept.
+    std::size_t empty_space_pruned = 0, low_contribution_pruned = 0, weakly_seen_ground_pruned = 0;
     bool empty_space_swept = false;
 };
 
@@ -157,9 +157,11 @@ class Trainer {
     void post_densification_prune(std::int64_t iteration, StepReport& report);
     // Renders every training photo's geometry and removes the surfels with more than
     // empty_space_prune_share of their blend weight on pixels that must stay empty, and at the `last`
-    // iteration those whose weight summed over the photos is below min_contribution_pixels; counts them in
-    // `report`.
+    // iteration those whose weight summed over the photos is below min_contribution_pixels; with
+    // min_ground_views, the weakly seen surfels below the cameras; counts them in `report`.
     void sweep_and_prune(bool last, StepReport& report);
+    // The height along up_ of the lowest training camera: below it lies the ground min_ground_views watches.
+    double lowest_camera_height() const;
     // The pixels of training photo `view` that must stay empty: its sky or an object's outside, or
     // without masks (with a sky background and lambda_background_alpha) the pixels whose sky the photo
     // already shows under its current light (the sky drawn with `horizon`); empty when the photo has none.
