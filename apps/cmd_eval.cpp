@@ -74,8 +74,11 @@ void run_gt_env(const EvalOptions& o) {
         if (run.image_names.empty())
             std::printf("  light scale k = 1 (a bare PLY: no learned lights to fit it on)\n");
         else
-            std::printf("  light scale k = %.6g (fit on %zu training photos, relative residual %.3f)\n",
-                        result.light.scale, result.light.per_photo.size(), result.light.relative_residual);
+            std::printf(
+                "  light scale k = %.6g (fit on %zu training photos, relative residual %.3f); learned "
+                "lights %.2f x as directional as the true ones, %.0f deg off (medians)\n",
+                result.light.scale, result.light.per_photo.size(), result.light.relative_residual,
+                result.light.median_direction_strength, result.light.median_direction_error_deg);
         for (const GtEnvImageResult& im : result.images)
             std::printf("  %-24s %-14s shadowed PSNR %6.2f SSIM %.4f | unshadowed PSNR %6.2f SSIM %.4f\n",
                         im.name.c_str(), im.condition.c_str(), im.shadowed.psnr, im.shadowed.ssim,
@@ -108,7 +111,8 @@ void run_gt_env(const EvalOptions& o) {
     std::printf(
         "eval-summary: shadowed_psnr=%.4f shadowed_ssim=%.4f unshadowed_psnr=%.4f unshadowed_ssim=%.4f "
         "albedo_psnr=%.4f normal_mean_deg=%.3f normal_median_deg=%.3f render_ms=%.2f sky_alpha=%.4f "
-        "light_residual=%.4f empty=%.4f covered_psnr=%.4f scaled_psnr=%.4f sky_mean_alpha=%.4f\n",
+        "light_residual=%.4f empty=%.4f covered_psnr=%.4f scaled_psnr=%.4f sky_mean_alpha=%.4f "
+        "light_direction=%.4f light_direction_error_deg=%.2f\n",
         result.mean_shadowed.psnr, result.mean_shadowed.ssim, result.mean_unshadowed.psnr,
         result.mean_unshadowed.ssim, result.has_albedo ? result.mean_albedo.psnr : nan,
         result.has_normal ? result.mean_normal.mean_deg : nan,
@@ -116,7 +120,8 @@ void run_gt_env(const EvalOptions& o) {
         result.has_sky ? result.sky_alpha_fraction : nan, result.light.relative_residual,
         result.empty_fraction, result.mean_covered_shadowed_psnr,
         result.image_scaled ? result.mean_image_scaled_shadowed.psnr : nan,
-        result.has_sky ? result.sky_mean_alpha : nan);
+        result.has_sky ? result.sky_mean_alpha : nan, result.light.median_direction_strength,
+        result.light.median_direction_error_deg);
     std::printf("eval: wrote %s/metrics.json and %s/report.md (%.1f s)\n", o.out.c_str(), o.out.c_str(), s);
 }
 

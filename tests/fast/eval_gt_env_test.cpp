@@ -1,7 +1,7 @@
 // The gt-env protocol (eval/gt_env.h): the light-scale fit (known answer, training photos only, the
-// irradiance weighting), a model built from the tiny synthetic scene's ground-truth surfels (the scale it
-// implies, its normal and albedo errors), invariance under the model's albedo/light gauge, and errors that
-// name the missing file.
+// irradiance weighting), how directional the learned lights are, a model built from the tiny synthetic
+// scene's ground-truth surfels (the scale it implies, its normal and albedo errors), invariance under the
+// model's albedo/light gauge, and errors that name the missing file.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -73,6 +73,42 @@ TEST(EvalGtEnv, LightScaleKnownAnswer) {
 
     EXPECT_THROW(fit_light_scale({}, {}, {}), Error);
     EXPECT_THROW(fit_light_scale(learned, truth, {1.0}), Error);
+}
+
+// An SH light with luminance DC `dc` and the same band-1 vector `b1` on every channel.
+ShCoeffs<double> dipole_light(double dc, Vec3d b1) {
+    ShCoeffs<double> s{};
+    s.c[0] = Vec3d{dc, dc, dc};
+    for (int j = 1; j < 4; ++j) s.c[j] = Vec3d{b1[j - 1], b1[j - 1], b1[j - 1]};
+    s.c[5] = Vec3d{0.2, 0.1, 0.3};  // band 2 does not enter
+    return s;
+}
+
+TEST(EvalGtEnv, LightDirectionKnownAnswer) {
+    const ShCoeffs<double> truth = dipole_light(3.0, {0.5, 1.0, -0.3});
+    // A scaled copy is exactly as directional, in the same direction.
+    LightDirection d = light_direction(scaled(truth, 0.4), truth);
+    EXPECT_NEAR(d.strength, 1.0, 1e-12);
+    EXPECT_NEAR(d.error_deg, 0.0, 1e-6);
+    // Half the dipole for the same DC: half as directional.
+    d = light_direction(dipole_light(3.0, {0.25, 0.5, -0.15}), truth);
+    EXPECT_NEAR(d.strength, 0.5, 1e-12);
+    EXPECT_NEAR(d.error_deg, 0.0, 1e-6);
+    // A dipole at right angles: 90 deg, and a reversed one 180.
+    d = light_direction(dipole_light(1.5, {1.0, -0.5, 0.0}), truth);
+    EXPECT_NEAR(d.error_deg, 90.0, 1e-9);
+    EXPECT_NEAR(light_direction(dipole_light(3.0, {-0.5, -1.0, 0.3}), truth).error_deg, 180.0, 1e-6);
+    // No direction in the truth, or no light: undefined.
+    EXPECT_TRUE(std::isnan(light_direction(truth, dipole_light(3.0, {0.01, 0.0, 0.0})).strength));
+    EXPECT_TRUE(std::isnan(light_direction(dipole_light(0.0, {1, 0, 0}), truth).error_deg));
+    // The fit's medians skip the undefined photos.
+    const std::vector<ShCoeffs<double>> learned = {scaled(truth, 0.4), dipole_light(3.0, {0.25, 0.5, -0.15}),
+                                                   dipole_light(3.0, {1, 1, 1})};
+    const std::vector<ShCoeffs<double>> truths = {truth, truth, dipole_light(3.0, {0, 0, 0})};
+    const LightScaleFit fit = fit_light_scale(learned, truths, {1.0, 1.0, 1.0});
+    ASSERT_EQ(fit.direction.size(), 3u);
+    EXPECT_NEAR(fit.median_direction_strength, 0.75, 1e-12);
+    EXPECT_NEAR(fit.median_direction_error_deg, 0.0, 1e-6);
 }
 
 TEST(EvalGtEnv, LightScaleWeightsAreTheIrradianceIntegralOverTheSphere) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "lumigauss/relight/relit_render.h"
 #include "lumigauss/shading/irradiance.h"
@@ -14,6 +15,39 @@ namespace lumigauss {
 double irradiance_weight(int j) {
     const double a = j == 0 ? rh_const::kA0 : (j < 4 ? rh_const::kA1 : rh_const::kA2);
     return a * a;
+}
+
+namespace {
+
+// The luminance DC and band-1 vector of an SH light.
+double luminance(const Vec3d& rgb) {
+    return (rgb[0] + rgb[1] + rgb[2]) / 3;
+}
+Vec3d band1(const ShCoeffs<double>& sh) {
+    return {luminance(sh.c[1]), luminance(sh.c[2]), luminance(sh.c[3])};
+}
+
+// The median of the finite values; NaN when there is none.
+double finite_median(std::vector<double> values) {
+    std::erase_if(values, [](double v) { return !std::isfinite(v); });
+    if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+    const std::size_t mid = values.size() / 2;
+    std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(mid), values.end());
+    if (values.size() % 2 == 1) return values[mid];
+    return 0.5 * (values[mid] + *std::max_element(values.begin(), values.begin() + std::ptrdiff_t(mid)));
+}
+
+}  // namespace
+
+LightDirection light_direction(const ShCoeffs<double>& learned, const ShCoeffs<double>& truth) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double learned_dc = luminance(learned.c[0]), true_dc = luminance(truth.c[0]);
+    const Vec3d l = band1(learned), t = band1(truth);
+    if (!(learned_dc > 0) || !(true_dc > 0) || !(length(t) >= 0.05 * true_dc)) return {nan, nan};
+    const double strength = (length(l) / learned_dc) / (length(t) / true_dc);
+    // The band-1 coefficients are a fixed signed permutation of the dipole's x, y, z: angles carry over.
+    const double cosine = length(l) > 0 ? dot(l, t) / (length(l) * length(t)) : nan;
+    return {strength, std::acos(std::clamp(cosine, -1.0, 1.0)) * 180.0 / std::numbers::pi};
 }
 
 LightScaleFit fit_light_scale(const std::vector<ShCoeffs<double>>& learned,
@@ -38,7 +72,13 @@ LightScaleFit fit_light_scale(const std::vector<ShCoeffs<double>>& learned,
         const double e = exposure[i];
         lt += e * lt_i, tt += e * e * tt_i;
         fit.per_photo.push_back(tt_i > 0 ? lt_i / (e * tt_i) : std::numeric_limits<double>::quiet_NaN());
+        fit.direction.push_back(light_direction(learned[i], truth[i]));
     }
+    std::vector<double> strengths, errors;
+    for (const LightDirection& d : fit.direction)
+        strengths.push_back(d.strength), errors.push_back(d.error_deg);
+    fit.median_direction_strength = finite_median(strengths);
+    fit.median_direction_error_deg = finite_median(errors);
     if (!(tt > 0)) throw Error("light scale: the true lighting of every training photo is zero");
     fit.scale = lt / tt;
     // sum w |L - k e T|^2 = ll - 2 k lt + k^2 tt, at the optimum ll - k lt.

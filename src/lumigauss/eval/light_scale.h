@@ -17,11 +17,27 @@ namespace lumigauss {
 // A_l(j)^2, the weight of coefficient j in the irradiance least squares.
 double irradiance_weight(int j);
 
+// How directional a learned light is against the true one (luminance: the mean of the channels). Band 1 of
+// a degree-2 SH is the light's dipole: its length over the DC says how much more light comes from one side,
+// its direction where from. A learned light can match the photos' brightness and still be too flat (the
+// sunlit and shaded sides of the scene then differ too little, and the difference goes into albedo and
+// shadow transfer): strength < 1.
+struct LightDirection {
+    double strength = 0;   // (|band 1| / DC) learned over (|band 1| / DC) true; NaN where the truth has none
+    double error_deg = 0;  // angle between the learned and true band-1 vectors; NaN likewise
+};
+
+// NaN for both when the true light has (nearly) no direction (|band 1| < 0.05 DC) or either DC is <= 0.
+LightDirection light_direction(const ShCoeffs<double>& learned, const ShCoeffs<double>& truth);
+
 struct LightScaleFit {
-    double scale = 1.0;              // k
-    double relative_residual = 0.0;  // sqrt(sum w |L - k e T|^2 / sum w |L|^2)
-    std::vector<std::string> names;  // the training photos used
-    std::vector<double> per_photo;   // each photo's own least-squares k_i (diagnostic)
+    double scale = 1.0;                     // k
+    double relative_residual = 0.0;         // sqrt(sum w |L - k e T|^2 / sum w |L|^2)
+    std::vector<std::string> names;         // the training photos used
+    std::vector<double> per_photo;          // each photo's own least-squares k_i (diagnostic)
+    std::vector<LightDirection> direction;  // per photo (diagnostic)
+    // Medians of `direction` over the photos where it is defined; NaN when none is.
+    double median_direction_strength = 0, median_direction_error_deg = 0;
 };
 
 // The global k of (1) above from matched lists. Throws Error when the lists are empty, differ in length, or

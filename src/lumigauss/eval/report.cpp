@@ -167,8 +167,13 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
     if (r.views == Split::Train)
         j["views_note"] = "diagnostic: training views under their own true lights (not the protocol)";
     Json per_photo = Json::object();
-    for (std::size_t i = 0; i < r.light.per_photo.size() && i < r.light.names.size(); ++i)
+    Json per_photo_direction = Json::object();
+    for (std::size_t i = 0; i < r.light.per_photo.size() && i < r.light.names.size(); ++i) {
         per_photo[r.light.names[i]] = number(r.light.per_photo[i]);
+        if (i < r.light.direction.size())
+            per_photo_direction[r.light.names[i]] = {{"strength", number(r.light.direction[i].strength)},
+                                                     {"error_deg", number(r.light.direction[i].error_deg)}};
+    }
     j["light_scale"] = {
         {"value", number(r.light.scale)},
         {"method",
@@ -176,7 +181,14 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
          "scale * exposure * true SH (coefficients weighted by A_l^2); training photos only"},
         {"train_photos", r.light.per_photo.size()},
         {"relative_residual", number(r.light.relative_residual)},
-        {"per_photo", per_photo}};
+        {"per_photo", per_photo},
+        {"direction_strength", number(r.light.median_direction_strength)},
+        {"direction_error_deg", number(r.light.median_direction_error_deg)},
+        {"direction_method",
+         "per training photo, (|band 1| / DC) of the learned SH over that of the true SH (luminance, the "
+         "mean of the channels) and the angle between their band-1 vectors; medians over the photos whose "
+         "true light has a direction (|band 1| >= 0.05 DC)"},
+        {"per_photo_direction", per_photo_direction}};
     j["test_exposure"] = "each test photo's meta.json exposure (its camera setting, not lighting) is applied";
     j["mask"] = r.gt_mask ? "gt/mask eroded 5x5 once, full coverage only, times the scene mask"
                           : "scene mask eroded 5x5 once, full coverage only (no gt/mask)";
@@ -263,6 +275,12 @@ std::string gt_env_report_markdown(const GtEnvResult& r, const ReportSources& sr
          "their learned SH and `k * exposure * true SH` (SH coefficients weighted by A_l^2). Relative "
          "residual " +
          fmt("%.3f", r.light.relative_residual) + ".\n";
+    if (std::isfinite(r.light.median_direction_strength))
+        s +=
+            "- How directional the learned lights are (training photos, median): " +
+            fmt("%.2f", r.light.median_direction_strength) +
+            " x the true band-1 strength (|band 1| / DC; 1 = as directional as the truth), their direction " +
+            fmt("%.0f", r.light.median_direction_error_deg) + " deg from the true one.\n";
     if (r.sky_behind) {
         s += "- The run was trained with its sky behind the surfels: renders are drawn over the condition's "
              "panorama (`env/COND.exr`; its SH where there is none) times `k * exposure`";
