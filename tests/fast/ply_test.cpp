@@ -1,4 +1,5 @@
-// PLY container and the 2DGS surfel layout: round trips, foreign encodings, errors, activations, view SH.
+// PLY container and the 2DGS surfel layout (and what the relightable reader refuses): round trips, foreign
+// encodings, errors, activations, view SH.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 
 #include "io_test_util.h"
 #include "lumigauss/io/ply.h"
+#include "lumigauss/model/relightable_ply.h"
 #include "lumigauss/model/splat_ply.h"
 #include "lumigauss/model/view_sh.h"
 
@@ -121,6 +123,30 @@ TEST(Ply, ElementsWithoutPropertiesAreSkippedAtOnce) {
     out.write(reinterpret_cast<const char*>(&x), 4);
     out.close();
     EXPECT_EQ(read_ply_vertices(dir / "e.ply").column("x", "")[0], 2.5f);
+}
+
+// A vertex element without properties holds no bytes, so no file size bounds its count, and the model
+// readers sized their arrays by it (libFuzzer: a 184-byte relightable PLY declaring 671,698,203,059 vertices
+// asked for 8 TB; fuzz/regressions/relightable_ply/vertex_without_properties). Refused, and so is a second
+// vertex element.
+TEST(Ply, AVertexElementWithoutPropertiesOrTwiceIsRefused) {
+    TempDir dir;
+    write_text(dir / "bare.ply",
+               "ply\nformat binary_little_endian 1.0\nelement vertex 671698203059\nend_header\n");
+    expect_error([&] { read_ply_vertices(dir / "bare.ply"); },
+                 {"bare.ply", "671698203059 vertices but no properties"});
+    expect_error([&] { load_2dgs_ply(dir / "bare.ply"); }, {"bare.ply", "no properties"});
+    expect_error([&] { load_relightable_ply(dir / "bare.ply"); }, {"bare.ply", "no properties"});
+    write_text(dir / "twice.ply",
+               "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nelement vertex 1\nproperty float "
+               "y\nend_header\n1\n2\n");
+    expect_error([&] { read_ply_vertices(dir / "twice.ply"); },
+                 {"twice.ply", "'vertex' element is declared twice"});
+    // A model reader looks up its columns before it allocates for them.
+    write_text(dir / "x_only.ply",
+               "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nend_header\n1\n2\n");
+    expect_error([&] { load_2dgs_ply(dir / "x_only.ply"); }, {"x_only.ply", "'y'"});
+    expect_error([&] { load_relightable_ply(dir / "x_only.ply"); }, {"x_only.ply", "'y'"});
 }
 
 TEST(Ply, ErrorsNameTheFileAndTheProblem) {

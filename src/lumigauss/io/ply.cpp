@@ -285,7 +285,15 @@ PlyVertexTable read_ply_vertices(const std::string& path) {
     bool found = false;
     for (const PlyElement& e : h.elements) {
         PlyVertexTable* target = nullptr;
-        if (e.name == "vertex" && !found) {
+        if (e.name == "vertex") {
+            // Two vertex elements: which one is the model? And one without properties holds no bytes, so the
+            // file cannot bound its count, which the readers above size their models by (a 184-byte file
+            // declaring 671,698,203,059 vertices made load_relightable_ply ask for 8 TB; libFuzzer,
+            // fuzz/regressions/relightable_ply/vertex_without_properties).
+            if (found) fail_in_file(path, "the 'vertex' element is declared twice");
+            if (e.properties.empty())
+                fail_in_file(path, "the 'vertex' element declares " + std::to_string(e.count) +
+                                       " vertices but no properties");
             found = true;
             check_declared_count(e, h.format, data_bytes, path);  // before allocating for it
             table.count = e.count;

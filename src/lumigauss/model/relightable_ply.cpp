@@ -62,6 +62,8 @@ void save_relightable_ply(const std::string& path, const SurfelModel& model) {
 SurfelModel load_relightable_ply(const std::string& path) {
     const PlyVertexTable table = read_ply_vertices(path);
     if (table.count == 0) fail_in_file(path, "the model has no surfels (0 vertices)");
+    // Every column first: a file with a few of them must not make us allocate the whole model.
+    for (const Field& f : fields()) (void)table.column(f.name, path);
     const std::size_t n = table.count;
     std::vector<std::vector<float>> raw(kModelParamCount);
     for (int p = 0; p < kModelParamCount; ++p)

@@ -34,6 +34,10 @@ ViewDependentSurfels load_2dgs_ply(const std::string& path) {
     while (t.has("f_rest_" + std::to_string(rest))) ++rest;
     ViewDependentSurfels m;
     m.sh_degree = degree_from_rest_count(rest, path);
+    // Every column first: a file with a few of them must not make us allocate the whole model.
+    for (const char* name : {"x", "y", "z", "rot_0", "rot_1", "rot_2", "rot_3", "scale_0", "scale_1",
+                             "opacity", "f_dc_0", "f_dc_1", "f_dc_2"})
+        (void)t.column(name, path);
     const std::size_t n = t.count;
     const int nk = view_sh_coefficients(m.sh_degree);
     m.surfels.channels = 3;
