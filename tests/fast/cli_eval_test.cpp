@@ -119,6 +119,8 @@ TEST(CliEval, BarePlyIsEvaluatedWithLightScaleOne) {
     EXPECT_THAT(r.output, HasSubstr("light scale k = 1 (a bare PLY"));
     const nlohmann::json m = synth_test::read_json(tmp / "report/metrics.json");
     EXPECT_EQ(m["light_scale"]["value"].get<double>(), 1.0);
+    // No learned lights, so nothing to say about their direction (not a misleading 0).
+    EXPECT_THAT(r.output, HasSubstr("light_direction=nan"));
 }
 
 TEST(CliEval, MissingModelIsNamed) {

@@ -2,6 +2,7 @@
 // The light scale of the gt-env protocol (eval/gt_env.h, steps 1 and 8): the one gauge factor k between a
 // run's learned lights and a scene's true ones, fitted on the training photos only.
 #include <array>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -36,8 +37,9 @@ struct LightScaleFit {
     std::vector<std::string> names;         // the training photos used
     std::vector<double> per_photo;          // each photo's own least-squares k_i (diagnostic)
     std::vector<LightDirection> direction;  // per photo (diagnostic)
-    // Medians of `direction` over the photos where it is defined; NaN when none is.
-    double median_direction_strength = 0, median_direction_error_deg = 0;
+    // Medians of `direction` over the photos where it is defined; NaN when none is (or nothing was fitted).
+    double median_direction_strength = std::numeric_limits<double>::quiet_NaN();
+    double median_direction_error_deg = std::numeric_limits<double>::quiet_NaN();
 };
 
 // The global k of (1) above from matched lists. Throws Error when the lists are empty, differ in length, or
