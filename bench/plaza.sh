@@ -20,6 +20,7 @@
 #   fast-no-empty-prune     surfels painting the sky (most of their weight on empty pixels) not removed
 #                           (empty_space_prune_share=0)
 #   fast-no-low-contribution  surfels adding under 4 pixels to all the photos kept (min_contribution_pixels=0)
+#   fast-no-traced-shadows  the shadow transfer learned per surfel, as officially (geometric_transfer_every=0)
 #   fast-no-ground-seeds    no starting points on the bare ground under the cameras (ground_seeds=false)
 #   fast-no-ground          black below the horizon where no surfel covers a pixel (ground_backdrop=false)
 #   fast-no-horizon         the sky drawn in every direction, below the horizon too (sky_horizon_fade=0;
@@ -78,6 +79,7 @@ if [[ $ablations == 1 ]]; then
     add_row fast-no-prune-end "--preset fast --set prune_until_end=false"
     add_row fast-no-empty-prune "--preset fast --set empty_space_prune_share=0"
     add_row fast-no-low-contribution "--preset fast --set min_contribution_pixels=0"
+    add_row fast-no-traced-shadows "--preset fast --set geometric_transfer_every=0"
     add_row fast-no-ground-seeds "--preset fast --set ground_seeds=false"
     add_row fast-no-ground "--preset fast --set ground_backdrop=false"
     add_row fast-no-horizon "--preset fast --set sky_horizon_fade=0"

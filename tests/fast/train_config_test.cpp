@@ -144,6 +144,8 @@ std::vector<MemberChange> every_member() {
         {"empty_space_prune_share", [](TrainConfig& c) { c.empty_space_prune_share = 0.6; }},
         {"min_contribution_pixels", [](TrainConfig& c) { c.min_contribution_pixels = 2.5; }},
         {"min_ground_views", [](TrainConfig& c) { c.min_ground_views = 3; }},
+        {"geometric_transfer_every", [](TrainConfig& c) { c.geometric_transfer_every = 500; }},
+        {"shadow_bounce", [](TrainConfig& c) { c.shadow_bounce = 0.25; }},
         {"ground_backdrop", [](TrainConfig& c) { c.ground_backdrop = true; }},
         {"checkpoint_interval", [](TrainConfig& c) { c.checkpoint_interval = 0; }},
         {"log_interval", [](TrainConfig& c) { c.log_interval = 1; }},
@@ -255,7 +257,8 @@ TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
                                                 "ground_seeds",
                                                 "empty_space_prune_share",
                                                 "ground_backdrop",
-                                                "min_contribution_pixels"};
+                                                "min_contribution_pixels",
+                                                "geometric_transfer_every"};
     for (const auto& [improved, base] : {std::pair{"default", "paper"}, std::pair{"fast", "paper-fast"}}) {
         SCOPED_TRACE(improved);
         const Json a = Json::parse(train_config_to_json(train_preset(improved)));
@@ -277,6 +280,9 @@ TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
     EXPECT_EQ(paper.empty_space_prune_share, 0.0);
     EXPECT_EQ(paper.min_contribution_pixels, 0.0);
     EXPECT_EQ(paper.min_ground_views, 0);
+    EXPECT_EQ(paper.geometric_transfer_every, 0);
+    EXPECT_EQ(train_preset("default").geometric_transfer_every, 1000);
+    EXPECT_EQ(train_preset("fast").geometric_transfer_every, 500);
     EXPECT_FALSE(paper.ground_backdrop);
     EXPECT_FALSE(paper.ground_seeds);
 }
@@ -302,7 +308,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 72, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 74, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;
@@ -674,6 +680,9 @@ TEST(TrainConfigValidate, RejectsEachBadValueNamingTheKey) {
         {"min_contribution_pixels", [](TrainConfig& c) { c.min_contribution_pixels = 1e9; }},
         {"min_ground_views", [](TrainConfig& c) { c.min_ground_views = -1; }},
         {"min_ground_views", [](TrainConfig& c) { c.min_ground_views = 1001; }},
+        {"geometric_transfer_every", [](TrainConfig& c) { c.geometric_transfer_every = -1; }},
+        {"shadow_bounce", [](TrainConfig& c) { c.shadow_bounce = -0.1; }},
+        {"shadow_bounce", [](TrainConfig& c) { c.shadow_bounce = 1.5; }},
         {"lambda_scale_ratio", [](TrainConfig& c) { c.lambda_scale_ratio = -0.1; }},
         {"max_scale_ratio", [](TrainConfig& c) { c.max_scale_ratio = 0.5; }},
         {"max_scale_ratio", [](TrainConfig& c) { c.max_scale_ratio = 1e7; }},
@@ -747,7 +756,7 @@ TEST(TrainConfigSchedule, IterationsScaleTheStagesAndWindowsNotTheRhythms) {
     EXPECT_EQ(
         schedule_summary(c),
         "stages: unshadowed 1-149, transfer fitting 150-160, shadowed 161-300; densification 10-120 every "
-        "100, opacity reset every 600");
+        "100, opacity reset every 600; shadows traced from the geometry every 500");
 
     // Tiny runs keep one transfer-fitting iteration and the stage order; longer ones stretch.
     TrainConfig tiny = train_preset("default");

@@ -109,6 +109,8 @@ constexpr std::array kFields = {
     LUMIGAUSS_FIELD(empty_space_prune_share),
     LUMIGAUSS_FIELD(min_contribution_pixels),
     LUMIGAUSS_FIELD(min_ground_views),
+    LUMIGAUSS_FIELD(geometric_transfer_every),
+    LUMIGAUSS_FIELD(shadow_bounce),
     LUMIGAUSS_FIELD(lambda_opacity),
     LUMIGAUSS_FIELD(lambda_scale_ratio),
     LUMIGAUSS_FIELD(max_scale_ratio),
@@ -406,6 +408,9 @@ void add_improvements(TrainConfig& config) {
     config.densify_near_fraction = 0.37;  // Pixel-GS's value; -5 deg of test-view normal error on plaza
     config.empty_space_prune_share = 0.5;
     config.min_contribution_pixels = 4.0;
+    // Shadows traced through the surfels instead of learned per surfel (fast preset, 3 scenes, 4 runs,
+    // bench/RESULTS.md session 33: shadowed gt-env +0.12 to +0.39 dB, SSIM up in all, albedo +1.3 dB on 3).
+    config.geometric_transfer_every = 1000;
     config.downscale = 0;  // -r auto: large photos at most 1600 px (run_all.sh's -r 1 is off)
 }
 
@@ -421,6 +426,7 @@ TrainConfig train_preset(std::string_view name) {
     if (name == "paper") return config;
     if (name == "paper-fast" || name == "fast") shrink_schedule(config);
     if (name == "default" || name == "fast") add_improvements(config);
+    if (name == "fast") config.geometric_transfer_every = 500;  // four bakes in its 1400 shadowed iterations
     if (name == "paper-fast" || name == "fast" || name == "default") {
         config.preset = std::string(name);
         return config;
@@ -456,6 +462,8 @@ std::string schedule_summary(const TrainConfig& c) {
     if (c.iterations > c.start_shadowed) s += ", shadowed " + n(c.start_shadowed + 1) + "-" + n(c.iterations);
     s += "; densification " + n(c.densify_from) + "-" + n(c.densify_until) + " every " +
          n(c.densify_interval) + ", opacity reset every " + n(c.opacity_reset_interval);
+    if (c.geometric_transfer_every > 0 && c.iterations > c.start_shadowed)
+        s += "; shadows traced from the geometry every " + n(c.geometric_transfer_every);
     return s;
 }
 
@@ -618,6 +626,10 @@ void validate_train_config(const TrainConfig& c) {
             c.min_contribution_pixels, "must be in [0, 1e6] pixels (0: off)");
     require(c.min_ground_views >= 0 && c.min_ground_views <= 1000, "min_ground_views", c.min_ground_views,
             "must be in [0, 1000] photos (0: off)");
+    require(c.geometric_transfer_every >= 0, "geometric_transfer_every", c.geometric_transfer_every,
+            "must be >= 0 iterations (0: off)");
+    require(c.shadow_bounce >= 0.0 && c.shadow_bounce <= 1.0, "shadow_bounce", c.shadow_bounce,
+            "must be in [0, 1]");
     require(c.max_scale_ratio >= 1.0 && c.max_scale_ratio <= 1e6, "max_scale_ratio", c.max_scale_ratio,
             "must be in [1, 1e6]");
     if (c.mask_mode != "transient" && c.mask_mode != "object")

@@ -162,6 +162,15 @@ struct TrainConfig {
     // photos the near ground they alone saw (their tile joints), and on the demo scenes the backdrop left
     // in their place is a darker band (-0.16 dB on the temple; bench/RESULTS.md, session 32).
     int min_ground_views = 0;
+    // In the shadowed stage, every surfel's transfer is the SH projection of the light its own model lets
+    // reach it (model/visibility_transfer.h: the other surfels traced as shadow casters), baked at the
+    // stage's first iteration, every geometric_transfer_every iterations and at the last one, and frozen
+    // in between (no transfer losses, no transfer learning rate): the shadows come from the geometry instead
+    // of being learned per surfel from the training lights alone; 0 = off (the learned transfer).
+    std::int64_t geometric_transfer_every = 0;
+    // The share of the blocked light the baked transfer lets through, as the blocker's reflection
+    // (VisibilityTransferOptions::bounce): the photos hold interreflections, which nothing else carries.
+    double shadow_bounce = 0.5;
 
     // Run bookkeeping (not in the official code).
     std::int64_t checkpoint_interval = 1000;  // iterations between checkpoints; 0 = only at the end/interrupt

@@ -31,6 +31,11 @@ namespace {
 constexpr std::uint64_t kCameraOrder = 0x63616d6f72646572ULL;  // "camorder"
 constexpr std::uint64_t kEnvNoise = 0x656e766e6f697365ULL;     // "envnoise"
 constexpr std::uint64_t kDensify = 0x64656e736966ULL;          // "densif"
+// config geometric_transfer_every, as fractions of the scene extent: shadow rays start a little off the
+// surfel, and parallel surfels this near its plane are layers of the same surface (a trained ground is
+// a stack of surfels about a metre deep in a 100 m plaza; bench/RESULTS.md, session 33).
+constexpr double kTransferStartFraction = 0.001;
+constexpr double kTransferLayerFraction = 0.01;
 
 using Clock = std::chrono::steady_clock;
 
@@ -353,6 +358,10 @@ void Trainer::set_learning_rates(std::int64_t iteration) {
     const bool frozen = iteration > c.warmup && iteration <= c.start_shadowed;
     const bool late = iteration > c.start_shadowed;
     state_.model.adam(ModelParam::Rotation).set_lr(frozen ? 0.0 : c.lr_rotation);
+    // A baked transfer is not learned: its Adam moments from stage 2 must not go on moving it.
+    const double transfer_lr = late && c.geometric_transfer_every > 0 ? 0.0 : c.lr_transfer;
+    state_.model.adam(ModelParam::TransferPositive).set_lr(transfer_lr);
+    state_.model.adam(ModelParam::TransferNegative).set_lr(transfer_lr);
     for (int g = 0; g < kMlpGroupCount; ++g) {
         const double base = MlpGroup(g) == MlpGroup::kEmbedding ? c.lr_embedding : c.lr_mlp;
         state_.lighting_adam[std::size_t(g)].set_lr(frozen ? 0.0 : late ? base / c.lr_env_final_ratio : base);
@@ -373,6 +382,7 @@ StepReport Trainer::step() {
 
     report.view = view_for_iteration(it);
     last_view_ = report.view;
+    if (stage == Stage::Shadowed && bakes_transfer(it)) bake_transfer();
     compute_view_normals(state_.model, views_[std::size_t(report.view)].camera, scratch_->normals);
     if (stage != Stage::TransferFitting) render_step(it, stage, report);
     physical_step(it, stage, report);
@@ -554,9 +564,31 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     times_.shading_backward += seconds_since(t0);
 }
 
+bool Trainer::bakes_transfer(std::int64_t it) const {
+    const TrainConfig& c = state_.config;
+    if (c.geometric_transfer_every <= 0) return false;
+    const std::int64_t since = it - (c.start_shadowed + 1);
+    return since >= 0 && (since % c.geometric_transfer_every == 0 || it == c.iterations);
+}
+
+VisibilityTransferOptions Trainer::geometric_transfer_options() const {
+    VisibilityTransferOptions options;
+    options.start_distance = kTransferStartFraction * state_.scene_extent;
+    options.layer_thickness = kTransferLayerFraction * state_.scene_extent;
+    options.bounce = state_.config.shadow_bounce;
+    return options;
+}
+
+void Trainer::bake_transfer() {
+    const auto t0 = Clock::now();
+    bake_visibility_transfer(state_.model, geometric_transfer_options());
+    times_.physical += seconds_since(t0);
+}
+
 void Trainer::physical_step(std::int64_t it, Stage stage, StepReport& report) {
     if (stage == Stage::Unshadowed) return;  // stage 1: the transfer gets no gradient (5)
     const TrainConfig& c = state_.config;
+    if (stage == Stage::Shadowed && c.geometric_transfer_every > 0) return;  // baked, not learned
     const auto t0 = Clock::now();
     TransferLossWeights<double> w;
     w.range01 = c.lambda_range01;

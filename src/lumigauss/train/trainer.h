@@ -17,6 +17,7 @@
 #include "lumigauss/model/lighting_mlp.h"
 #include "lumigauss/model/sky_residual.h"
 #include "lumigauss/model/view_shading.h"
+#include "lumigauss/model/visibility_transfer.h"
 #include "lumigauss/render/raster_types.h"
 #include "lumigauss/render/rasterizer.h"
 #include "lumigauss/shading/sky_image.h"
@@ -132,6 +133,9 @@ class Trainer {
     // Where the sky drawn behind the surfels ends below the horizon (config sky_horizon_*; the cameras'
     // mean up), and the ground drawn there (config ground_backdrop: the current surfels' ground albedo).
     SkyHorizon sky_horizon() const;
+    // How config geometric_transfer_every bakes the transfer (model/visibility_transfer.h): the ray start and
+    // the ground's layer thickness as fractions of the scene extent, config shadow_bounce.
+    VisibilityTransferOptions geometric_transfer_options() const;
     // The training view used at a given iteration (a fresh permutation of the photos per epoch).
     int view_for_iteration(std::int64_t iteration) const;
 
@@ -152,6 +156,10 @@ class Trainer {
     void set_learning_rates(std::int64_t iteration);
     void render_step(std::int64_t iteration, Stage stage, StepReport& report);
     void physical_step(std::int64_t iteration, Stage stage, StepReport& report);
+    // config geometric_transfer_every: whether this shadowed-stage iteration bakes the transfer, and the
+    // bake.
+    bool bakes_transfer(std::int64_t iteration) const;
+    void bake_transfer();
     void densify_step(std::int64_t iteration, Stage stage, StepReport& report);
     // After densification: the prune goes on (prune_until_end) and painters of empty space are removed.
     void post_densification_prune(std::int64_t iteration, StepReport& report);
