@@ -11,19 +11,14 @@
 #include "lumigauss/model/surfel_occlusion.h"
 #include "lumigauss/shading/irradiance.h"
 #include "lumigauss/shading/sh.h"
+#include "lumigauss/util/rng.h"
 
 namespace lumigauss {
 
 namespace {
 
-// A small counter-based hash (splitmix64) for the per-surfel jitter: deterministic, thread-order free.
-double jitter(std::uint64_t key) {
-    key += 0x9E3779B97F4A7C15ull;
-    key = (key ^ (key >> 30)) * 0xBF58476D1CE4E5B9ull;
-    key = (key ^ (key >> 27)) * 0x94D049BB133111EBull;
-    key ^= key >> 31;
-    return double(key >> 11) * 0x1.0p-53;
-}
+// The stream of each surfel side's jitter (util/rng.h): deterministic and free of the thread order.
+constexpr std::uint64_t kDirectionJitter = 0x7669736a6974ULL;  // "visjit"
 
 struct SideTransfer {
     double coeffs[kShCount];
@@ -32,7 +27,7 @@ struct SideTransfer {
 
 SideTransfer side_transfer(const SurfelOcclusion& occlusion, SurfelOcclusion::RayScratch& scratch,
                            std::size_t surfel, Vec3d centre, const Mat3<double>& frame, double side,
-                           double t_min, double layer_thickness, const VisibilityTransferOptions& options) {
+                           const VisibilityTransferOptions& options) {
     const Vec3d n = frame.col(2) * side, tu = frame.col(0), tv = frame.col(1) * side;
     SideTransfer out{};
     cosine_lobe_sh(n, out.coeffs);
@@ -40,14 +35,14 @@ SideTransfer side_transfer(const SurfelOcclusion& occlusion, SurfelOcclusion::Ra
     const int count = rows * rows;
     const double weight = std::numbers::pi / count;
     double lit = 0.0;
+    Rng jitter(hash_keys(options.seed, kDirectionJitter, surfel, side > 0 ? 1 : 0));
     for (int k = 0; k < count; ++k) {
-        const std::uint64_t key = (std::uint64_t(options.seed) << 48) ^ (std::uint64_t(surfel) << 9) ^
-                                  (std::uint64_t(side > 0) << 8) ^ std::uint64_t(k);
-        const double u1 = ((k / rows) + jitter(2 * key)) / rows,
-                     u2 = ((k % rows) + jitter(2 * key + 1)) / rows;
+        const double u1 = ((k / rows) + jitter.uniform()) / rows;
+        const double u2 = ((k % rows) + jitter.uniform()) / rows;
         const double r = std::sqrt(u1), phi = 2.0 * std::numbers::pi * u2;
         const Vec3d dir = tu * (r * std::cos(phi)) + tv * (r * std::sin(phi)) + n * std::sqrt(1.0 - u1);
-        const double v = occlusion.transmittance({centre, dir, t_min, surfel, n, layer_thickness}, scratch);
+        const double v = occlusion.transmittance(
+            {centre, dir, options.start_distance, surfel, n, options.layer_thickness}, scratch);
         const double blocked = (1.0 - v) * (1.0 - options.bounce);
         lit += v;
         if (blocked <= 0.0) continue;
@@ -64,7 +59,6 @@ SideTransfer side_transfer(const SurfelOcclusion& occlusion, SurfelOcclusion::Ra
 VisibilityTransferReport bake_visibility_transfer(SurfelModel& model,
                                                   const VisibilityTransferOptions& options) {
     const SurfelOcclusion occlusion(model);
-    const double t_min = options.start_distance, layer = options.layer_thickness;
     tbb::enumerable_thread_specific<SurfelOcclusion::RayScratch> scratches(
         [&] { return occlusion.scratch(); });
     tbb::combinable<double> visibility_sum([] { return 0.0; }), shadowed([] { return 0.0; });
@@ -78,8 +72,7 @@ VisibilityTransferReport bake_visibility_transfer(SurfelModel& model,
         const Mat3<double> frame = Mat3<double>::from_columns(
             r.col(0).cast<double>(), r.col(1).cast<double>(), r.col(2).cast<double>());
         for (const double side : {1.0, -1.0}) {
-            const SideTransfer t =
-                side_transfer(occlusion, scratch, i, centre, frame, side, t_min, layer, options);
+            const SideTransfer t = side_transfer(occlusion, scratch, i, centre, frame, side, options);
             float* stored = (side > 0 ? positive.data() : negative.data()) + i * kTransferStored;
             for (int j = 0; j < kShCount; ++j)
                 for (int c = 0; c < 3; ++c) stored[j * 3 + c] = float(t.coeffs[j]);
