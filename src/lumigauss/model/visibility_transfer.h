@@ -18,7 +18,7 @@ namespace lumigauss {
 struct VisibilityTransferOptions {
     // The hemisphere's K = rows * rows directions, one per stratum. 8 (64 directions): against 576 the
     // shading of the fast plaza model's surfels differs by 1.3 % RMS (12 rows: 0.7 %), and trainings score
-    // the same as with 12 rows at 2.25x less bake time (bench/RESULTS.md, session 34).
+    // the same as with 12 rows in half the bake time (bench/RESULTS.md, session 34).
     int direction_rows = 8;
     // Crossings nearer than this (model units) do not count, so that neighbours of the same surface, tilted
     // a little, do not shade it.
