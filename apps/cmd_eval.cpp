@@ -51,6 +51,11 @@ DatasetOptions evaluated_resolution(const EvalOptions& o, int run_downscale) {
     return dopt;
 }
 
+// The mean over the channels of a surface's gain to the photos (eval-summary's up_gain, other_gain).
+double mean_gain(const SurfaceRegion& r) {
+    return (r.gain(0) + r.gain(1) + r.gain(2)) / 3.0;
+}
+
 void run_gt_env(const EvalOptions& o) {
     const auto t0 = std::chrono::steady_clock::now();
     // Check the scene's ground truth before the (slower) model load, so a wrong scene fails at once.
@@ -92,6 +97,14 @@ void run_gt_env(const EvalOptions& o) {
         if (result.has_normal)
             std::printf("  normals: mean %.2f deg, median %.2f deg\n", result.mean_normal.mean_deg,
                         result.mean_normal.median_deg);
+        if (result.has_normal) {
+            const SurfaceRegion &up = result.surfaces.up, &other = result.surfaces.other;
+            std::printf(
+                "  by surface: facing up %.2f dB (gain to the photos %.3f %.3f %.3f), the rest %.2f dB "
+                "(gain %.3f %.3f %.3f)\n",
+                up.psnr(), up.gain(0), up.gain(1), up.gain(2), other.psnr(), other.gain(0), other.gain(1),
+                other.gain(2));
+        }
         if (result.has_sky)
             std::printf(
                 "  sky pixels (gt/mask = 0) with alpha > 0.5: %.2f %%; mean alpha over the sky %.4f\n",
@@ -112,7 +125,8 @@ void run_gt_env(const EvalOptions& o) {
         "eval-summary: shadowed_psnr=%.4f shadowed_ssim=%.4f unshadowed_psnr=%.4f unshadowed_ssim=%.4f "
         "albedo_psnr=%.4f normal_mean_deg=%.3f normal_median_deg=%.3f render_ms=%.2f sky_alpha=%.4f "
         "light_residual=%.4f empty=%.4f covered_psnr=%.4f scaled_psnr=%.4f sky_mean_alpha=%.4f "
-        "light_direction=%.4f light_direction_error_deg=%.2f\n",
+        "light_direction=%.4f light_direction_error_deg=%.2f up_psnr=%.4f other_psnr=%.4f up_gain=%.4f "
+        "other_gain=%.4f\n",
         result.mean_shadowed.psnr, result.mean_shadowed.ssim, result.mean_unshadowed.psnr,
         result.mean_unshadowed.ssim, result.has_albedo ? result.mean_albedo.psnr : nan,
         result.has_normal ? result.mean_normal.mean_deg : nan,
@@ -121,7 +135,10 @@ void run_gt_env(const EvalOptions& o) {
         result.empty_fraction, result.mean_covered_shadowed_psnr,
         result.image_scaled ? result.mean_image_scaled_shadowed.psnr : nan,
         result.has_sky ? result.sky_mean_alpha : nan, result.light.median_direction_strength,
-        result.light.median_direction_error_deg);
+        result.light.median_direction_error_deg, result.has_normal ? result.surfaces.up.psnr() : nan,
+        result.has_normal ? result.surfaces.other.psnr() : nan,
+        result.has_normal ? mean_gain(result.surfaces.up) : nan,
+        result.has_normal ? mean_gain(result.surfaces.other) : nan);
     std::printf("eval: wrote %s/metrics.json and %s/report.md (%.1f s)\n", o.out.c_str(), o.out.c_str(), s);
 }
 

@@ -130,18 +130,19 @@ done
 
 echo
 echo "gt-env on $scene (test views: novel views under novel lights; light scale fitted on training photos only)"
-printf '%-30s %8s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s %7s %7s %8s %8s %8s %8s\n' run "shad.PSNR" "shad.SSIM" \
-       "unsh.PSNR" "unsh.SSIM" "alb.PSNR" "norm.mean" "norm.med" "trainmed" "sky%" "skyveil" "lightres" "lightdir" "empty%" \
-       "cov.PSNR" "img.PSNR" "train min" "surfels"
+printf '%-30s %8s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s %7s %7s %8s %8s %8s %8s %8s %8s\n' run "shad.PSNR" \
+       "shad.SSIM" "unsh.PSNR" "unsh.SSIM" "alb.PSNR" "norm.mean" "norm.med" "trainmed" "sky%" "skyveil" "lightres" \
+       "lightdir" "empty%" "cov.PSNR" "img.PSNR" "walls" "wallgain" "train min" "surfels"
 while read -r name seconds surfels train_median rest; do
     declare -A m=()
     for kv in $rest; do m[${kv%%=*}]=${kv#*=}; done
-    printf '%-30s %8.2f %8.4f %8.2f %8.4f %8.2f %8.2f %8.2f %8.2f %7.2f %7.4f %7.3f %7.2f %7.2f %8.2f %8.2f %8.1f %8s\n' "$name" \
+    printf '%-30s %8.2f %8.4f %8.2f %8.4f %8.2f %8.2f %8.2f %8.2f %7.2f %7.4f %7.3f %7.2f %7.2f %8.2f %8.2f %8.2f %8.3f %8.1f %8s\n' "$name" \
            "${m[shadowed_psnr]}" "${m[shadowed_ssim]}" "${m[unshadowed_psnr]}" "${m[unshadowed_ssim]}" \
            "${m[albedo_psnr]}" "${m[normal_mean_deg]}" "${m[normal_median_deg]}" "$train_median" \
            "$(awk -v s="${m[sky_alpha]}" 'BEGIN { print 100 * s }')" "${m[sky_mean_alpha]:-nan}" "${m[light_residual]}" \
            "${m[light_direction]:-nan}" "$(awk -v s="${m[empty]}" 'BEGIN { print 100 * s }')" "${m[covered_psnr]}" \
-           "${m[scaled_psnr]:-nan}" "$(awk -v s="$seconds" 'BEGIN { print s / 60 }')" "$surfels"
+           "${m[scaled_psnr]:-nan}" "${m[other_psnr]:-nan}" "${m[other_gain]:-nan}" \
+           "$(awk -v s="$seconds" 'BEGIN { print s / 60 }')" "$surfels"
     unset m
 done < "$summary"
 echo "(norm.mean/norm.med: normal error on the test views, degrees; trainmed: median normal error on the"
@@ -150,4 +151,7 @@ echo " mean alpha over those sky pixels (faint surfels in front of the cameras t
 echo " relative residual of the light-scale fit, 0 when every learned light is one common scale of the true one;"
 echo " lightdir: how directional the learned lights are, median |band 1|/DC over the true one's (1 = as the truth);"
 echo " empty%: evaluated test pixels the model leaves empty (alpha <= 0.5); cov.PSNR: shadowed PSNR over the others;"
-echo " img.PSNR: shadowed PSNR with the light scale fitted per channel on the training images instead)"
+echo " img.PSNR: shadowed PSNR with the light scale fitted per channel on the training images instead;"
+echo " walls: shadowed PSNR over the pixels whose true normal is not within 25 deg of up (walls, roofs);"
+echo " wallgain: the gain that would take the render onto the photos there, mean over RGB: 1 when their"
+echo " albedo is right against the ground's)"

@@ -311,6 +311,46 @@ TEST(EvalGtEnv, ImageLightScaleFollowsTheColourGauge) {
     EXPECT_FALSE(evaluate_gt_env(plain, scene, meta, opt).image_scaled);
 }
 
+// Step 9: the evaluated pixels split by the true normal. The true surfels under the true light need about
+// the same gain on both kinds of surface; the same model with every surfel that does not face up darkened to
+// 0.8 of its albedo (display value) needs 1/0.8 more there and nothing more on the ground.
+TEST(EvalGtEnv, BySurfaceFindsWallsDarkerThanTheGround) {
+    const std::string& root = tiny_scene();
+    const Dataset scene = load_dataset(root);
+    const GtSceneMeta meta = load_gt_scene_meta(root);
+    GtEnvOptions opt;
+    opt.keep_panels = false;
+    opt.image_light_scale = false;
+    const RelightableRun truth = oracle_run(root, 1.0);
+    RelightableRun dark_walls = truth;
+    std::vector<float>& albedo = dark_walls.model.param(ModelParam::Albedo);
+    for (std::size_t i = 0; i < dark_walls.model.size(); ++i) {
+        if (std::abs(dark_walls.model.normal(i).z) > 0.9f) continue;
+        for (int c = 0; c < 3; ++c) {
+            float& raw = albedo[3 * i + std::size_t(c)];
+            raw = float((0.8 * (sh_const::kY00 * raw + 0.5) - 0.5) / sh_const::kY00);
+        }
+    }
+    const GtEnvResult a = evaluate_gt_env(truth, scene, meta, opt);
+    const GtEnvResult b = evaluate_gt_env(dark_walls, scene, meta, opt);
+    ASSERT_TRUE(a.has_normal);
+    ASSERT_GT(a.surfaces.up.pixels, 200u);
+    ASSERT_GT(a.surfaces.other.pixels, 200u);
+    EXPECT_EQ(a.surfaces.up.pixels, b.surfaces.up.pixels);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(a.surfaces.up.gain(c), 1.0, 0.3) << c;
+        EXPECT_NEAR(a.surfaces.other.gain(c), 1.0, 0.3) << c;
+        EXPECT_NEAR(b.surfaces.up.gain(c) / a.surfaces.up.gain(c), 1.0, 0.03) << c;
+        EXPECT_NEAR(b.surfaces.other.gain(c) / a.surfaces.other.gain(c), 1.25, 0.06) << c;
+    }
+    // The ground keeps its score up to the edges where wall surfels blend into it; the walls' score moves
+    // (up here: without shadows the true surfels' walls are brighter than the photos, gain about 0.8).
+    EXPECT_NEAR(a.surfaces.up.psnr(), b.surfaces.up.psnr(), 0.5);
+    EXPECT_GT(std::abs(b.surfaces.other.psnr() - a.surfaces.other.psnr()), 1.0);
+    const nlohmann::ordered_json j = gt_env_metrics_json(b, {"run", root});
+    EXPECT_TRUE(j["mean"]["by_surface"]["other"].contains("gain_rgb"));
+}
+
 TEST(EvalGtEnv, AWrongLightScaleScoresWorse) {
     // The same model with its learned light 4x too bright for every photo (training photos included) no
     // longer renders its training photos; the fitted k follows the learned light, so the test renders are

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <numbers>
 
 #include "lumigauss/eval/sky_coverage.h"
 #include "lumigauss/relight/relit_render.h"
@@ -15,6 +16,23 @@
 #include "lumigauss/util/error.h"
 
 namespace lumigauss {
+SurfaceRegion& SurfaceRegion::operator+=(const SurfaceRegion& o) {
+    pixels += o.pixels, squared_error += o.squared_error;
+    for (int c = 0; c < 3; ++c)
+        photo_dot_render[c] += o.photo_dot_render[c], render_squared[c] += o.render_squared[c];
+    return *this;
+}
+
+double SurfaceRegion::psnr() const {
+    return pixels > 0 ? psnr_from_mse(squared_error / (3.0 * double(pixels)))
+                      : std::numeric_limits<double>::quiet_NaN();
+}
+
+double SurfaceRegion::gain(int channel) const {
+    return pixels > 0 && render_squared[channel] > 0 ? photo_dot_render[channel] / render_squared[channel]
+                                                     : std::numeric_limits<double>::quiet_NaN();
+}
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -112,6 +130,27 @@ void score_empty_pixels(const RasterImages<float>& relit, GtEnvImageResult& r) {
                                   : std::numeric_limits<double>::quiet_NaN();
 }
 
+// The shadowed render against the photo over the evaluated pixels, split by the true normal (header, step 9).
+// `decoded` holds the true normals (2v - 1).
+SurfaceSplit split_by_surface(const SheetPanels& p, const Image& decoded) {
+    SurfaceSplit split;
+    const double cos_up = std::cos(kUpFacingDeg * std::numbers::pi / 180.0);
+    for (std::size_t q = 0; q < p.mask.pixels.size(); ++q) {
+        if (!(p.mask.pixels[q] > 0.5f)) continue;
+        const Vec3d n{decoded.pixels[3 * q], decoded.pixels[3 * q + 1], decoded.pixels[3 * q + 2]};
+        const double len = length(n);
+        SurfaceRegion& r = len > 0 && n.z / len > cos_up ? split.up : split.other;
+        ++r.pixels;
+        for (int c = 0; c < 3; ++c) {
+            const double render = p.shadowed.pixels[3 * q + c], photo = p.truth.pixels[3 * q + c];
+            r.squared_error += (render - photo) * (render - photo);
+            r.photo_dot_render[c] += photo * render;
+            r.render_squared[c] += render * render;
+        }
+    }
+    return split;
+}
+
 // The rendered normals against gt/normal (header, step 7), and the error panel.
 void score_normals(const std::string& gt_normal_path, const Image& rendered_normal, GtEnvImageResult& r,
                    std::vector<double>& pooled_angles) {
@@ -122,6 +161,7 @@ void score_normals(const std::string& gt_normal_path, const Image& rendered_norm
     Image decoded = p.gt_normal;
     for (float& x : decoded.pixels) x = 2.0f * x - 1.0f;
     r.normal = normal_angular_error(rendered_normal, decoded, p.mask, 1e-3, &pooled_angles);
+    r.surfaces = split_by_surface(p, decoded);
     p.normal_error = Image(w, h, 1);
     for (std::size_t q = 0; q < p.normal_error.pixels.size(); ++q) {
         if (!(p.mask.pixels[q] > 0.5f)) continue;
@@ -282,6 +322,7 @@ void summarize_views(GtEnvResult& result) {
         if (!std::isnan(r.covered_shadowed_psnr))
             result.mean_covered_shadowed_psnr += r.covered_shadowed_psnr, ++covered_images;
         render_ms.push_back(r.render_ms);
+        result.surfaces.up += r.surfaces.up, result.surfaces.other += r.surfaces.other;
     }
     result.empty_fraction = evaluated > 0 ? empty / double(evaluated) : 0.0;
     result.mean_covered_shadowed_psnr = covered_images > 0

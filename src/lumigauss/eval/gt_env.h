@@ -44,6 +44,12 @@
 //    0.05), and one scalar cannot follow the model's colour gauge (albedo_c * s_c with E_c * s_c^(-2.2)
 //    renders every training photo the same, for each channel apart). The test views are scored again under
 //    k_c * exposure * true SH ("image-scaled"); the metrics of 3 stay the protocol's headline.
+// 9. By surface (when gt/normal exists): the evaluated pixels split by the true normal into those facing up
+//    (within 25 deg of +z, the scenes' up: ground, terraces) and the rest (walls, roofs, columns), each with
+//    its shadowed PSNR (squared error pooled over the scored images) and the least-squares gain per channel
+//    that would take the render onto the photo there. Gains near 1 on one and not on the other say that the
+//    model's albedo of one kind of surface is off against the other's (on plaza the walls come out a third
+//    too dark: bench/RESULTS.md, session 35), which no light scale can fix.
 // Ground-truth images are area-resampled to the evaluated resolution (-r) like the photos.
 #include <array>
 #include <string>
@@ -63,6 +69,22 @@ namespace lumigauss {
 struct AlbedoMetrics {
     double psnr = 0, mse = 0, mae = 0;
 };
+
+// Sums over the pixels of one kind of surface (header, step 9), shadowed render against the photo.
+struct SurfaceRegion {
+    std::size_t pixels = 0;
+    double squared_error = 0;                  // summed over the pixels and the three channels
+    std::array<double, 3> photo_dot_render{};  // sum of photo x render, per channel
+    std::array<double, 3> render_squared{};    // sum of render^2, per channel
+    SurfaceRegion& operator+=(const SurfaceRegion& o);
+    double psnr() const;             // NaN without pixels
+    double gain(int channel) const;  // least-squares photo / render; NaN without pixels
+};
+struct SurfaceSplit {
+    SurfaceRegion up, other;
+};
+// The true normals within this angle of +z count as facing up.
+inline constexpr double kUpFacingDeg = 25.0;
 
 struct GtEnvImageResult {
     std::string name, condition;
@@ -85,6 +107,7 @@ struct GtEnvImageResult {
     bool has_albedo = false, has_normal = false;
     AlbedoMetrics albedo, albedo_gamma;
     AngularErrorStats normal;
+    SurfaceSplit surfaces;  // header, step 9 (with has_normal)
     SheetPanels panels;
 };
 
@@ -112,6 +135,7 @@ struct GtEnvResult {
     AlbedoMetrics mean_albedo, mean_albedo_gamma;
     AngularErrorStats mean_normal;    // mean of the per-image means and of the per-image medians
     AngularErrorStats pooled_normal;  // over every measured pixel of every test image
+    SurfaceSplit surfaces;            // summed over the scored images (with has_normal)
 };
 
 struct GtEnvOptions {

@@ -223,6 +223,22 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
     if (r.has_albedo)
         mean["albedo"] = albedo_json(r.mean_albedo), mean["albedo_gamma"] = albedo_json(r.mean_albedo_gamma);
     if (r.has_normal) mean["normal"] = normal_json(r.mean_normal, false);
+    if (r.has_normal) {
+        const auto region = [&](const SurfaceRegion& g) {
+            const std::size_t all = r.surfaces.up.pixels + r.surfaces.other.pixels;
+            return Json{{"fraction", number(all > 0 ? double(g.pixels) / double(all) : 0.0)},
+                        {"shadowed_psnr", number(g.psnr())},
+                        {"gain_rgb", rgb_json({g.gain(0), g.gain(1), g.gain(2)})}};
+        };
+        mean["by_surface"] = {
+            {"up", region(r.surfaces.up)},
+            {"other", region(r.surfaces.other)},
+            {"meaning",
+             "evaluated pixels whose true normal is within 25 deg of +z (ground) and the others (walls, "
+             "roofs), "
+             "over all scored images: shadowed PSNR, and the least-squares gain per channel that takes the "
+             "render onto the photo (a gain far from 1 on one kind of surface only: its albedo is off)"}};
+    }
     if (r.has_sky)
         mean["sky_alpha_above_half"] = {
             {"value", number(r.sky_alpha_fraction)},
@@ -341,6 +357,15 @@ std::string gt_env_report_markdown(const GtEnvResult& r, const ReportSources& sr
              "no photo constrains): shadowed PSNR " +
              fmt("%.2f", r.mean_image_scaled_shadowed.psnr) + " dB, SSIM " +
              fmt("%.4f", r.mean_image_scaled_shadowed.ssim) + ".\n";
+    if (r.has_normal) {
+        const auto gains = [&](const SurfaceRegion& g) {
+            return fmt("%.3f", g.gain(0)) + " " + fmt("%.3f", g.gain(1)) + " " + fmt("%.3f", g.gain(2));
+        };
+        s += "\nBy surface (true normal within 25 deg of up, or not): shadowed PSNR facing up " +
+             fmt("%.2f", r.surfaces.up.psnr()) + " dB (gain to the photos " + gains(r.surfaces.up) +
+             "), the rest " + fmt("%.2f", r.surfaces.other.psnr()) + " dB (gain " + gains(r.surfaces.other) +
+             ").\n";
+    }
     s += "\nEvaluated pixels the model leaves empty (alpha <= 0.5): " + fmt("%.2f", 100 * r.empty_fraction) +
          " %; shadowed PSNR over the covered ones " + fmt("%.2f", r.mean_covered_shadowed_psnr) + " dB.\n";
     if (r.has_sky)
