@@ -110,6 +110,8 @@ std::vector<MemberChange> every_member() {
         {"densify_interval", [](TrainConfig& c) { c.densify_interval = 100; }},
         {"opacity_reset_interval", [](TrainConfig& c) { c.opacity_reset_interval = 600; }},
         {"densify_grad_threshold", [](TrainConfig& c) { c.densify_grad_threshold = 0.00021; }},
+        {"lambda_ground_light", [](TrainConfig& c) { c.lambda_ground_light = 3.0; }},
+        {"ground_light_albedo", [](TrainConfig& c) { c.ground_light_albedo = 0.25; }},
         {"min_opacity", [](TrainConfig& c) { c.min_opacity = 0.005; }},
         {"opacity_reset_value", [](TrainConfig& c) { c.opacity_reset_value = 0.2; }},
         {"max_screen_size", [](TrainConfig& c) { c.max_screen_size = 0.0; }},
@@ -309,7 +311,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 74, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 76, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;
@@ -661,6 +663,9 @@ TEST(TrainConfigValidate, RejectsEachBadValueNamingTheKey) {
         {"densify_interval", [](TrainConfig& c) { c.densify_interval = 0; }},
         {"opacity_reset_interval", [](TrainConfig& c) { c.opacity_reset_interval = 0; }},
         {"densify_grad_threshold", [](TrainConfig& c) { c.densify_grad_threshold = -1e-4; }},
+        {"lambda_ground_light", [](TrainConfig& c) { c.lambda_ground_light = -1.0; }},
+        {"ground_light_albedo", [](TrainConfig& c) { c.ground_light_albedo = -0.1; }},
+        {"ground_light_albedo", [](TrainConfig& c) { c.ground_light_albedo = 1.5; }},
         {"min_opacity", [](TrainConfig& c) { c.min_opacity = -0.01; }},
         {"min_opacity", [](TrainConfig& c) { c.min_opacity = 1.0; }},
         {"opacity_reset_value", [](TrainConfig& c) { c.opacity_reset_value = 0.0; }},

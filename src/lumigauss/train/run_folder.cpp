@@ -24,6 +24,7 @@ std::string step_log_line(const StepReport& r, double elapsed_seconds, const Hel
     j["consistency"] = r.consistency;
     j["shadow"] = r.shadow;
     j["env"] = r.env;
+    j["ground_light"] = r.ground_light;
     j["normal"] = r.normal;
     j["distortion"] = r.distortion;
     j["sky_alpha"] = r.sky_alpha;

@@ -54,6 +54,8 @@ constexpr std::array kFields = {
     LUMIGAUSS_FIELD(lambda_unshadowed_stage3),
     LUMIGAUSS_FIELD(lambda_range01),
     LUMIGAUSS_FIELD(lambda_env),
+    LUMIGAUSS_FIELD(lambda_ground_light),
+    LUMIGAUSS_FIELD(ground_light_albedo),
     LUMIGAUSS_FIELD(lambda_consistency),
     LUMIGAUSS_FIELD(consistency_final_ratio),
     LUMIGAUSS_FIELD(lambda_shadow),
@@ -543,11 +545,12 @@ void validate_train_config(const TrainConfig& c) {
     require(c.start_regularization >= 0, "start_regularization", c.start_regularization, "must be >= 0");
 
     // Loss weights, noise, Monte Carlo.
-    const std::array<std::pair<std::string_view, double>, 10> non_negative = {{
+    const std::array<std::pair<std::string_view, double>, 11> non_negative = {{
         {"lambda_dssim", c.lambda_dssim},
         {"lambda_unshadowed_stage3", c.lambda_unshadowed_stage3},
         {"lambda_range01", c.lambda_range01},
         {"lambda_env", c.lambda_env},
+        {"lambda_ground_light", c.lambda_ground_light},
         {"lambda_consistency", c.lambda_consistency},
         {"consistency_final_ratio", c.consistency_final_ratio},
         {"lambda_shadow", c.lambda_shadow},
@@ -594,6 +597,8 @@ void validate_train_config(const TrainConfig& c) {
     require(c.densify_grad_threshold >= 0.0, "densify_grad_threshold", c.densify_grad_threshold,
             "must be >= 0");
     require(c.min_opacity >= 0.0 && c.min_opacity < 1.0, "min_opacity", c.min_opacity, "must be in [0, 1)");
+    require(c.ground_light_albedo >= 0.0 && c.ground_light_albedo <= 1.0, "ground_light_albedo",
+            c.ground_light_albedo, "must be in [0, 1] (a physical albedo; 0 = the model's own)");
     require(c.opacity_reset_value > 0.0 && c.opacity_reset_value < 1.0, "opacity_reset_value",
             c.opacity_reset_value, "must be in (0, 1)");
     require(c.max_screen_size >= 0.0, "max_screen_size", c.max_screen_size, "must be >= 0");

@@ -37,9 +37,14 @@ struct TrainConfig {
     double lambda_unshadowed_stage3 = 0.001;  // weight of the unshadowed image loss in stage 3
     double lambda_range01 = 0.001;            // l_[0,1]
     double lambda_env = 0.05;                 // l_+
-    double lambda_consistency = 10.0;         // l_consistency (10 for NeRF-OSR scenes, run_all.sh)
-    double consistency_final_ratio = 1.0;     // stage-3 l_consistency weight = lambda_consistency x this
-    double lambda_shadow = 10.0;              // l_shadow (stage 3)
+    // The light below the horizon pulled towards the ground's reflection (train/ground_light_prior.h);
+    // 0 = off, as officially. The ground's albedo it assumes: 0 = the model's own (in the gauge the sky
+    // pins), > 0 = this physical albedo in the colour of the model's ground (free of the gauge).
+    double lambda_ground_light = 0.0;
+    double ground_light_albedo = 0.0;
+    double lambda_consistency = 10.0;      // l_consistency (10 for NeRF-OSR scenes, run_all.sh)
+    double consistency_final_ratio = 1.0;  // stage-3 l_consistency weight = lambda_consistency x this
+    double lambda_shadow = 10.0;           // l_shadow (stage 3)
     double lambda_normal = 0.05;
     double lambda_distortion = 100.0;
 

@@ -15,6 +15,7 @@
 #include "lumigauss/shading/sky_image.h"
 #include "lumigauss/train/depth_normal.h"
 #include "lumigauss/train/empty_space_prune.h"
+#include "lumigauss/train/ground_light_prior.h"
 #include "lumigauss/train/image_losses.h"
 #include "lumigauss/train/physical_losses.h"
 #include "lumigauss/train/scale_ratio_penalty.h"
@@ -527,6 +528,11 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     }
     report.env = env_nonnegativity_loss(clean, c.env_samples, c.seed, it, c.lambda_env, g_env);
     report.total += c.lambda_env * report.env;
+    if (c.lambda_ground_light > 0) {
+        const Vec3d reflectance = ground_reflectance(ground_albedo(state_.model, up_), c.ground_light_albedo);
+        report.ground_light = ground_light_prior(clean, up_, reflectance, c.lambda_ground_light, g_env);
+        report.total += c.lambda_ground_light * report.ground_light;
+    }
     times_.losses += seconds_since(t0);
 
     t0 = Clock::now();

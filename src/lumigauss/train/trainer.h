@@ -64,7 +64,7 @@ struct StepReport {
     double l1_shadowed = 0, dssim_shadowed = 0;
     double l1_unshadowed = 0, dssim_unshadowed = 0;
     double range01 = 0, consistency = 0, shadow = 0;
-    double env = 0, normal = 0, distortion = 0;
+    double env = 0, ground_light = 0, normal = 0, distortion = 0;
     double sky_alpha = 0, sky_colour = 0, background_alpha = 0, opacity = 0, sky_residual = 0,
            scale_ratio = 0;
     double psnr = 0;  // masked PSNR of the stage's main render (shadowed in stage 3), 0 in stage 2
