@@ -200,6 +200,7 @@ void run_sol_nerf(const EvalOptions& o) {
     sopt.backend = choose_backend(o.backend);
     sopt.angles = o.angles;
     sopt.roots = {o.scene, o.env_root, o.mask_root};
+    sopt.sides = run.side_rule;
     const SolNerfResult result = evaluate_sol_nerf(run.model, scene, config, sopt);
     write_sol_nerf_report(o.out, result, {o.run, o.scene}, !o.no_sheets);
     if (!o.quiet) print_sol_nerf(result);

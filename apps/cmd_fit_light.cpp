@@ -174,7 +174,8 @@ void run_fit_light(FitLightOptions o) {
     if (!o.render.empty()) {
         const RasterImages<float> img =
             render_with_environment(run.model, in.camera, r.sh.cast<float>(),
-                                    o.fit.shadowed ? ShadingMode::Shadowed : ShadingMode::Unshadowed);
+                                    o.fit.shadowed ? ShadingMode::Shadowed : ShadingMode::Unshadowed,
+                                    RasterBackend::Cpu, run.side_rule);
         write_png(o.render, fitted_colour(run, in.camera, img, 0, r.sh));
     }
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -198,7 +198,8 @@ TEST(CliRelight, PhotoLightRenderIsTheLibraryRender) {
     const Dataset scene = load_dataset(t.scene);
     for (const View& v : scene.views) {
         const RasterImages<float> both =
-            render_with_environment(run.model, v.camera, run.lighting.env_sh(index), ShadingMode::Both);
+            render_with_environment(run.model, v.camera, run.lighting.env_sh(index), ShadingMode::Both,
+                                    RasterBackend::Cpu, run.side_rule);  // the side rule it was trained with
         const std::string stem = fs::path(v.name).stem().string();
         const Image sh = read_image(out + "/" + stem + "_shadowed.png");
         const Image un = read_image(out + "/" + stem + "_unshadowed.png");

@@ -73,10 +73,11 @@ struct HoldoutScene {
         // light fills what they leave uncovered.
         for (const View* v : d.split(Split::Test))
             write_png(v->image_path,
-                      fitted_colour(run, v->camera,
-                                    render_with_environment(run.model, v->camera, light.cast<float>(),
-                                                            ShadingMode::Shadowed),
-                                    0, light));
+                      fitted_colour(
+                          run, v->camera,
+                          render_with_environment(run.model, v->camera, light.cast<float>(),
+                                                  ShadingMode::Shadowed, RasterBackend::Cpu, run.side_rule),
+                          0, light));
         ok = true;
     }
 };

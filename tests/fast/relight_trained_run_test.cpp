@@ -132,6 +132,34 @@ TEST(RelightTrainedRun, SkyHorizonIsTheTrainingCamerasMeanUpWithTheConfigAngles)
     EXPECT_EQ(load_trained_run(dir).sky_horizon.fade_degrees, 0.0f);
 }
 
+// The side rule (shading/surfel_side.h) the run was trained with: config.json grazing_side_degrees about the
+// training photos' up, so that every render of the run shades as training did.
+TEST(RelightTrainedRun, SideRuleIsTheConfigAngleAboutTheTrainingPhotosUp) {
+    TempDir tmp("relight_trained_run_sides");
+    const std::string dir = write_run(tmp, 2, {"x.png", "y.png"});
+    {
+        std::ofstream c(run_paths(dir).config);
+        c << "{\"grazing_side_degrees\": 5}\n";
+    }
+    // Without scene.json the up is unknown: the official rule.
+    EXPECT_FALSE(load_trained_run(dir).side_rule.active());
+    SceneRecord record;
+    record.scene = "/nowhere", record.format = "colmap-text";
+    record.photos.push_back({"x.png", "train", {1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 0}, {}, false});
+    record.photos.push_back({"y.png", "train", {0, 0, -1, 0, 1, 0, 1, 0, 0}, {0, 0, 0}, {}, false});
+    save_scene_record(run_paths(dir).scene, record);
+    const SurfelSideRule rule = load_trained_run(dir).side_rule;
+    EXPECT_EQ(rule.grazing_degrees, 5.0f);
+    EXPECT_NEAR(rule.up.y, -1, 1e-6);  // the y-down world of these cameras
+    EXPECT_NEAR(rule.up.x, 0, 1e-6);
+    EXPECT_NEAR(rule.up.z, 0, 1e-6);
+    // Off in the config (the paper preset), or a run trained before the key: the official rule.
+    for (const char* config : {"{\"grazing_side_degrees\": 0}\n", "{}\n"}) {
+        std::ofstream(run_paths(dir).config) << config;
+        EXPECT_FALSE(load_trained_run(dir).side_rule.active()) << config;
+    }
+}
+
 TEST(RelightTrainedRun, NamesTheMissingOrInconsistentFile) {
     TempDir tmp("relight_trained_run_bad");
     EXPECT_THAT(message_of([&] { load_trained_run(tmp / "nothing"); }), HasSubstr("not a folder"));

@@ -149,6 +149,7 @@ std::vector<MemberChange> every_member() {
         {"geometric_transfer_every", [](TrainConfig& c) { c.geometric_transfer_every = 500; }},
         {"shadow_bounce", [](TrainConfig& c) { c.shadow_bounce = 0.25; }},
         {"ground_backdrop", [](TrainConfig& c) { c.ground_backdrop = true; }},
+        {"grazing_side_degrees", [](TrainConfig& c) { c.grazing_side_degrees = 5.0; }},
         {"checkpoint_interval", [](TrainConfig& c) { c.checkpoint_interval = 0; }},
         {"log_interval", [](TrainConfig& c) { c.log_interval = 1; }},
     };
@@ -259,6 +260,7 @@ TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
                                                 "ground_seeds",
                                                 "empty_space_prune_share",
                                                 "ground_backdrop",
+                                                "grazing_side_degrees",
                                                 "min_contribution_pixels"};
     for (const auto& [improved, base] : {std::pair{"default", "paper"}, std::pair{"fast", "paper-fast"}}) {
         SCOPED_TRACE(improved);
@@ -288,6 +290,7 @@ TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
     EXPECT_EQ(train_preset("fast").geometric_transfer_every, 500);
     EXPECT_FALSE(paper.ground_backdrop);
     EXPECT_FALSE(paper.ground_seeds);
+    EXPECT_EQ(paper.grazing_side_degrees, 0.0);
 }
 
 TEST(TrainConfigPreset, EveryPresetValidates) {
@@ -311,7 +314,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 76, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 77, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;
@@ -666,6 +669,8 @@ TEST(TrainConfigValidate, RejectsEachBadValueNamingTheKey) {
         {"lambda_ground_light", [](TrainConfig& c) { c.lambda_ground_light = -1.0; }},
         {"ground_light_albedo", [](TrainConfig& c) { c.ground_light_albedo = -0.1; }},
         {"ground_light_albedo", [](TrainConfig& c) { c.ground_light_albedo = 1.5; }},
+        {"grazing_side_degrees", [](TrainConfig& c) { c.grazing_side_degrees = -1.0; }},
+        {"grazing_side_degrees", [](TrainConfig& c) { c.grazing_side_degrees = 60.0; }},
         {"min_opacity", [](TrainConfig& c) { c.min_opacity = -0.01; }},
         {"min_opacity", [](TrainConfig& c) { c.min_opacity = 1.0; }},
         {"opacity_reset_value", [](TrainConfig& c) { c.opacity_reset_value = 0.0; }},

@@ -127,6 +127,19 @@ TEST(TrainTrainer, GroundLightPriorPullsTheLowerHalfTowardsTheGround) {
     EXPECT_LT(on, 0.5 * off) << "without " << off << ", with " << on;
 }
 
+// The side rule training shades with (shading/surfel_side.h): the config's angle about the photos' up, as
+// load_trained_run rebuilds it for every later render of the run.
+TEST(TrainTrainer, SideRuleIsTheConfigAngleAboutThePhotosUp) {
+    TrainConfig config = train_preset("fast");
+    config.iterations = 10;
+    EXPECT_EQ(make_trainer(config).side_rule().grazing_degrees, 5.0f);
+    config.grazing_side_degrees = 0;
+    const Trainer trainer = make_trainer(config);
+    EXPECT_FALSE(trainer.side_rule().active());
+    for (int k = 0; k < 3; ++k)
+        EXPECT_EQ(trainer.side_rule().up[k], trainer.sky_horizon().up[k]);  // the photos' up, as the sky's
+}
+
 TEST(TrainTrainer, ConstructorsRejectInconsistentInput) {
     TrainConfig config = train_preset("paper-fast");
     config.iterations = 10;

@@ -127,6 +127,7 @@ TEST(ViewSceneInfo, ListsGivenLightsThenPhotosThenUniform) {
     EXPECT_EQ(j["camera"]["R"][1][2].get<double>(), cam.rotation(1, 2));
     EXPECT_GT(j["radius"].get<double>(), 0.0);
     EXPECT_TRUE(j["sky_horizon"].is_null());  // trained without one
+    EXPECT_TRUE(j["side_rule"].is_null());    // the official side rule
 }
 
 TEST(ViewSceneInfo, PassesTheRunsSkyHorizonToTheViewer) {
@@ -141,6 +142,17 @@ TEST(ViewSceneInfo, PassesTheRunsSkyHorizonToTheViewer) {
     EXPECT_EQ(j["sky_horizon"]["start_degrees"].get<double>(), 4.0);
     EXPECT_EQ(j["sky_horizon"]["fade_degrees"].get<double>(), 4.0);
     EXPECT_EQ(j["sky_horizon"]["ground_albedo"][2].get<double>(), 0.75);  // the ground drawn below it
+}
+
+// The viewer's shader picks each surfel's side as the run was trained (shading/surfel_side.h).
+TEST(ViewSceneInfo, PassesTheRunsSideRuleToTheViewer) {
+    const Camera cam = testing::test_camera();
+    TrainedRun run = relight_test::in_memory_run(relight_test::random_model(cam, 4, 30), {"p0.jpg"});
+    run.side_rule = {{0, -1, 0}, 5.0f};
+    const nlohmann::json j =
+        nlohmann::json::parse(scene_json(describe_scene(run, {}, parse_up_axis("-y"), cam)));
+    EXPECT_EQ(j["side_rule"]["up"][1].get<double>(), -1.0);
+    EXPECT_EQ(j["side_rule"]["grazing_degrees"].get<double>(), 5.0);
 }
 
 TEST(ViewSceneInfo, UniformEnvironmentHasIrradianceOne) {

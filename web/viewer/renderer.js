@@ -137,8 +137,9 @@ export class SplatRenderer {
   // view: {R (rows), t, fx, fy, cx, cy, width, height}; env: Float32Array(27); mode: a MODES name;
   // ball: null or {mode: 0|1, size (pixels)}; sky: draw the light's sky behind the colour views;
   // horizon: null or the scene's sky_horizon {up, start_degrees, fade_degrees, ground_albedo} (where that
-  // sky ends, and the ground drawn below).
-  render(view, env, mode, ball, sky = false, horizon = null) {
+  // sky ends, and the ground drawn below); sides: null or the scene's side_rule {up, grazing_degrees}
+  // (which side of a surfel the camera sees, shading/surfel_side.h).
+  render(view, env, mode, ball, sky = false, horizon = null, sides = null) {
     const gl = this.gl;
     const { width, height } = view;
     if (this.canvas.width !== width || this.canvas.height !== height) {
@@ -169,6 +170,9 @@ export class SplatRenderer {
       gl.uniform1i(u.u_mode, m);
       gl.uniform1i(u.u_unitRange, this.floatTarget ? 0 : 1);
       gl.uniform3fv(u.u_env, env);
+      const sideUp = sides ? sides.up : [0, 0, 1];
+      gl.uniform3f(u.u_sideUp, sideUp[0], sideUp[1], sideUp[2]);
+      gl.uniform1f(u.u_grazingSine, sides ? Math.sin(Math.min(Math.max(sides.grazing_degrees, 0), 45) * Math.PI / 180) : 0);
       gl.enable(gl.BLEND);
       gl.blendFunc(gl.ONE, gl.ONE_MINUS_SRC_ALPHA);
       gl.bindVertexArray(this.splatVao);

@@ -3,7 +3,8 @@
 //   ray-splat intersection, screen filter, alpha: src/lumigauss/render/surfel_kernel.h (evaluate_splat)
 //   constants: src/lumigauss/render/raster_constants.h
 //   shading: src/lumigauss/shading/surfel_shading.h and irradiance.h, the side choice of
-//            train/view_shading.h (positive transfer set when the surfel's +z faces the camera)
+//            shading/surfel_side.h (sees_positive_side: the side facing the camera, or with the run's grazing
+//            rule the upper side of a level surfel seen within a few degrees of its plane)
 //   shadow image: relight/relit_render.h (1 - clamp(luma(I_unshadowed - I_shadowed), 0, 1000))
 //   normal image: render/raster_maps.h (encode_normals: (n/|n| + 1) / 2, black where |n| <= 1e-3)
 import { Y00, Y1, Y2, Y20, Y22 } from './sh.js';
@@ -54,6 +55,8 @@ uniform int u_mode;             // index into MODES
 uniform bool u_unitRange;       // no float target: signed values are encoded into [0, 1]
 ${SH_GLSL}
 uniform highp usampler2D u_order;  // back-to-front surfel indices, ORDER_WIDTH per row
+uniform vec3 u_sideUp;             // the run's side rule: the photos' up ...
+uniform float u_grazingSine;       // ... and sin(grazing_degrees); 0: the side facing the camera
 flat out vec3 v_pa, v_pb, v_pd, v_tw;
 flat out vec4 v_centerOpacity;  // filter centre (pixels), opacity, rho cutoff
 flat out vec3 v_colour;
@@ -111,6 +114,9 @@ void main() {
   float facing = -dot(mc, nc);
   if (facing == 0.0) { cull(); return; }
   float flip = facing > 0.0 ? 1.0 : -1.0;
+  float axisUp = dot(nw, u_sideUp);  // sees_positive_side (shading/surfel_side.h)
+  if (u_grazingSine > 0.0 && abs(axisUp) > ${f(0.9)} && abs(facing) < u_grazingSine * length(mc))
+    flip = axisUp > 0.0 ? 1.0 : -1.0;
   float fx = u_intr.x, fy = u_intr.y, cx = u_intr.z, cy = u_intr.w;
   vec3 tu = vec3(fx * a.x + cx * a.z, fx * b.x + cx * b.z, fx * mc.x + cx * mc.z);
   vec3 tv = vec3(fy * a.y + cy * a.z, fy * b.y + cy * b.z, fy * mc.y + cy * mc.z);

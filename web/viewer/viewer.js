@@ -267,7 +267,7 @@ class Viewer {
 
   draw(view, withBall = true) {
     this.renderer.render(view, this.env, this.mode, withBall && this.ball.mode !== 'off' ? this.ball : null,
-                         this.sky, this.scene.sky_horizon || null);
+                         this.sky, this.scene.sky_horizon || null, this.scene.side_rule || null);
   }
 
   // --- interactive use ---

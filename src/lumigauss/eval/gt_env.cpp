@@ -359,8 +359,14 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
             result.image_light_scale = *k;
         }
 
-    Evaluation e{run, scene, meta, options, RelitRenderer(run.model, options.backend), TruePanoramas(meta),
-                 {},  {}};
+    Evaluation e{run,
+                 scene,
+                 meta,
+                 options,
+                 RelitRenderer(run.model, options.backend, run.side_rule),
+                 TruePanoramas(meta),
+                 {},
+                 {}};
     for (const View* v : views) result.images.push_back(evaluate_view(e, *v, result));
     result.gt_mask = e.every_gt_mask;
     score_albedo(e.albedo_inputs, result);

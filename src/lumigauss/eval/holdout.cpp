@@ -127,7 +127,7 @@ HoldoutResult evaluate_holdout(const TrainedRun& run, const Dataset& scene, cons
     std::vector<const View*> views;
     const std::size_t count = options.max_views > 0 ? std::min(options.max_views, all.size()) : all.size();
     for (std::size_t i = 0; i < count; ++i) views.push_back(all[i * all.size() / count]);
-    RelitRenderer renderer(run.model, options.backend);
+    RelitRenderer renderer(run.model, options.backend, run.side_rule);
     std::vector<double> fit_ms, render_ms;
     for (const View* v : views) {
         result.images.push_back(evaluate_view(run, scene, *v, renderer, options));

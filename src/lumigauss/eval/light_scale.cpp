@@ -112,7 +112,7 @@ std::optional<std::array<double, 3>> fit_image_light_scale(const RelightableRun&
                                                            const GtSceneMeta& meta,
                                                            const std::vector<std::string>& exclude,
                                                            RasterBackend backend) {
-    RelitRenderer renderer(run.model, backend);
+    RelitRenderer renderer(run.model, backend, run.side_rule);
     std::array<double, 3> rp{}, rr{};
     for (const View* v : scene.split(Split::Train)) {
         const GtImageMeta* im = meta.find(v->name);

@@ -10,8 +10,9 @@
 
 namespace lumigauss {
 
-MultiLightRenderer::MultiLightRenderer(const SurfelModel& model, RasterBackend backend)
-    : model_(model), renderer_(backend) {}
+MultiLightRenderer::MultiLightRenderer(const SurfelModel& model, RasterBackend backend,
+                                       const SurfelSideRule& sides)
+    : model_(model), renderer_(backend, sides) {}
 
 void MultiLightRenderer::shade_pass(std::span<const ShCoeffs<float>> envs, const ViewNormals& normals,
                                     SurfelBatch<float>& batch) const {

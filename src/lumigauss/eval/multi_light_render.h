@@ -25,7 +25,9 @@ inline constexpr int kLightsPerPass = kMaxChannels / 3;  // 5 environments per r
 
 class MultiLightRenderer {
   public:
-    explicit MultiLightRenderer(const SurfelModel& model, RasterBackend backend = RasterBackend::Cpu);
+    // `sides`: the run's side rule (TrainedRun::side_rule).
+    explicit MultiLightRenderer(const SurfelModel& model, RasterBackend backend = RasterBackend::Cpu,
+                                const SurfelSideRule& sides = {});
     // The shadowed colour (3 channels, unclamped, black background) of `camera` under each environment, in
     // order: the same as render_with_environment(model, camera, env, ShadingMode::Shadowed).color.
     std::vector<Image> render_shadowed(const Camera& camera, std::span<const ShCoeffs<float>> envs);

@@ -27,6 +27,7 @@ RelightableRun load_relightable_run(const std::string& path) {
     run.downscale = trained.downscale;
     run.sky_background = trained.sky_background;
     run.sky_horizon = trained.sky_horizon;
+    run.side_rule = trained.side_rule;
     return run;
 }
 

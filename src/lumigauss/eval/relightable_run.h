@@ -9,6 +9,7 @@
 #include "lumigauss/model/surfel_model.h"
 #include "lumigauss/shading/sh.h"
 #include "lumigauss/shading/sky_image.h"
+#include "lumigauss/shading/surfel_side.h"
 
 namespace lumigauss {
 
@@ -20,6 +21,7 @@ struct RelightableRun {
     int downscale = 0;                         // config.json "downscale"; 0 if unknown
     bool sky_background = false;               // trained with the photo's sky behind the surfels
     SkyHorizon sky_horizon;                    // where that sky ends below the horizon (TrainedRun's)
+    SurfelSideRule side_rule;                  // which side of a surfel a camera sees (TrainedRun's)
 };
 
 // A run folder (model.ply, lighting.lgmlp, appearance.json and config.json if present) or a bare relightable

@@ -175,8 +175,8 @@ SolNerfResult evaluate_sol_nerf(const SurfelModel& model, const Dataset& scene, 
     result.config_path = config.path;
     result.downscale = scene.downscale;
     result.angles = options.angles > 0 ? options.angles : config.angles;
-    MultiLightRenderer search(model, options.backend);
-    RelitRenderer final_render(model, options.backend);
+    MultiLightRenderer search(model, options.backend, options.sides);
+    RelitRenderer final_render(model, options.backend, options.sides);
     for (const SolNerfImageConfig& image : config.images) {
         result.images.push_back(evaluate_image(image, scene, config, options, search, final_render));
         result.search_seconds += result.images.back().search_ms / 1e3;

@@ -32,6 +32,7 @@
 #include "lumigauss/model/surfel_model.h"
 #include "lumigauss/render/rasterizer.h"
 #include "lumigauss/shading/sh.h"
+#include "lumigauss/shading/surfel_side.h"
 
 namespace lumigauss {
 
@@ -93,6 +94,7 @@ struct SolNerfOptions {
     int angles = 0;  // > 0: overrides the config's count
     SolNerfRoots roots;
     RasterBackend backend = RasterBackend::Cpu;
+    SurfelSideRule sides;  // the run's side rule (RelightableRun::side_rule)
 };
 
 // Runs the protocol for every image of `config` on `scene` (loaded at the resolution to evaluate) with the

@@ -11,6 +11,9 @@
 // Y_lm(d) is -c_l 4 pi / (2l + 1) Y_lm(n) H for odd l, and the DC coefficient is (M - 0.5) / Y_00 (3DGS adds
 // 0.5). The step has no even part: degree 2 holds degree 1's values and zero degree-2 coefficients.
 // Degree 0 (one colour) is the side the cameras see more (baked_colours.h: seen_side_colours).
+// A run's grazing rule (shading/surfel_side.h: a level surfel seen within a few degrees of its plane shows
+// its upper side) is not baked: the expansion is smooth in s and blends both sides near s = 0 whatever the
+// rule, and there a surfel covers least.
 #include <span>
 #include <vector>
 

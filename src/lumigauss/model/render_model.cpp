@@ -2,12 +2,13 @@
 
 namespace lumigauss {
 
-ModelRenderer::ModelRenderer(RasterBackend backend) : rasterizer_(make_rasterizer(backend)) {}
+ModelRenderer::ModelRenderer(RasterBackend backend, const SurfelSideRule& sides)
+    : rasterizer_(make_rasterizer(backend)), sides_(sides) {}
 
 const RasterImages<float>& ModelRenderer::render(const SurfelModel& model, const Camera& camera,
                                                  const SurfelShader& shade,
                                                  const RasterSettings<float>& settings) {
-    compute_view_normals(model, camera, normals_);
+    compute_view_normals(model, camera, normals_, sides_);
     model.activated(batch_);
     shade(normals_, batch_);
     rasterizer_->forward(camera, batch_, settings, images_);
@@ -34,8 +35,8 @@ const RasterImages<float>& ModelRenderer::render(const SurfelModel& model, const
 
 RasterImages<float> render_with_environment(const SurfelModel& model, const Camera& camera,
                                             const ShCoeffs<float>& env, ShadingMode mode,
-                                            RasterBackend backend) {
-    ModelRenderer renderer(backend);
+                                            RasterBackend backend, const SurfelSideRule& sides) {
+    ModelRenderer renderer(backend, sides);
     return renderer.render(model, camera, env, mode);
 }
 

@@ -17,10 +17,11 @@ namespace lumigauss {
 // Writes the colours of every surfel for one view: batch.channels and batch.colors (the geometry is set).
 using SurfelShader = std::function<void(const ViewNormals& normals, SurfelBatch<float>& batch)>;
 
-// Keeps its buffers and its rasterizer from render to render (loops over views and lights).
+// Keeps its buffers and its rasterizer from render to render (loops over views and lights). `sides` is the
+// run's side rule (TrainedRun::side_rule; {} = official), so that every render shades as training did.
 class ModelRenderer {
   public:
-    explicit ModelRenderer(RasterBackend backend = RasterBackend::Cpu);
+    explicit ModelRenderer(RasterBackend backend = RasterBackend::Cpu, const SurfelSideRule& sides = {});
 
     // `model` from `camera`, each surfel coloured by `shade`.
     const RasterImages<float>& render(const SurfelModel& model, const Camera& camera,
@@ -43,6 +44,7 @@ class ModelRenderer {
 
   private:
     std::unique_ptr<Rasterizer> rasterizer_;
+    SurfelSideRule sides_;
     ViewNormals normals_;
     SurfelBatch<float> batch_;
     RasterImages<float> images_;
@@ -51,6 +53,7 @@ class ModelRenderer {
 // One render into fresh maps: colour (3 or 6 channels), alpha, depth, normal, ...
 RasterImages<float> render_with_environment(const SurfelModel& model, const Camera& camera,
                                             const ShCoeffs<float>& env, ShadingMode mode,
-                                            RasterBackend backend = RasterBackend::Cpu);
+                                            RasterBackend backend = RasterBackend::Cpu,
+                                            const SurfelSideRule& sides = {});
 
 }  // namespace lumigauss

@@ -64,6 +64,20 @@ SkyHorizon recorded_sky_horizon(const nlohmann::json& config, const std::optiona
     return horizon;
 }
 
+// The side rule the run was trained with (Trainer::side_rule): config grazing_side_degrees about the up of
+// the training photos. The official rule when either is missing.
+SurfelSideRule recorded_side_rule(const nlohmann::json& config, const std::optional<Vec3d>& up) {
+    SurfelSideRule rule;
+    if (!up || !config.is_object() || !config.contains("grazing_side_degrees") ||
+        !config["grazing_side_degrees"].is_number())
+        return rule;
+    const double degrees = config["grazing_side_degrees"].get<double>();
+    if (!(degrees > 0 && degrees <= 45)) return rule;
+    rule.up = up->cast<float>();
+    rule.grazing_degrees = float(degrees);
+    return rule;
+}
+
 }  // namespace
 
 int TrainedRun::find_image(const std::string& name) const {
@@ -127,6 +141,7 @@ TrainedRun load_trained_run(const std::string& dir) {
         if (c.is_object() && c.contains("sky_background") && c["sky_background"].is_boolean())
             run.sky_background = c["sky_background"].get<bool>();
         run.sky_horizon = recorded_sky_horizon(c, run.photos_up);
+        run.side_rule = recorded_side_rule(c, run.photos_up);
         const bool object_masks = c.is_object() && c.contains("mask_mode") && c["mask_mode"].is_string() &&
                                   c["mask_mode"] == "object";
         if (c.is_object() && c.contains("ground_backdrop") && c["ground_backdrop"].is_boolean() &&

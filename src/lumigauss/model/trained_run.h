@@ -12,6 +12,7 @@
 #include "lumigauss/model/surfel_model.h"
 #include "lumigauss/shading/sh.h"
 #include "lumigauss/shading/sky_image.h"
+#include "lumigauss/shading/surfel_side.h"
 
 namespace lumigauss {
 
@@ -37,6 +38,9 @@ struct TrainedRun {
     // without it, as the run was trained then), and with config.json ground_backdrop the ground drawn there
     // (its albedo from the surfels, model/ground_albedo.h, as training computed it at its last iteration).
     SkyHorizon sky_horizon;
+    // Which side of each surfel a camera sees, as the run was trained: config.json grazing_side_degrees
+    // about photos_up (shading/surfel_side.h); the official rule without either.
+    SurfelSideRule side_rule;
 
     // Embedding index of the training photo called exactly `name`, or -1.
     int find_image(const std::string& name) const;

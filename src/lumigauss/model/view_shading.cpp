@@ -13,19 +13,21 @@ int shading_channels(ShadingMode mode) {
     return mode == ShadingMode::Both ? kSurfelColourChannels : 3;
 }
 
-void compute_view_normals(const SurfelModel& model, const Camera& camera, ViewNormals& out) {
+void compute_view_normals(const SurfelModel& model, const Camera& camera, ViewNormals& out,
+                          const SurfelSideRule& rule) {
     const std::size_t n = model.size();
     out.normal.resize(n);
     out.positive_side.resize(n);
     const Mat3f w = camera.rotation.cast<float>();
     const Vec3f t = camera.translation.cast<float>();
     const auto& xyz = model.param(ModelParam::Xyz);
+    const float grazing_sine = rule.grazing_sine();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i < r.end(); ++i) {
             const Vec3f axis = model.normal(i);
             const Vec3f p_view = w * Vec3f{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]} + t;
-            // Official: cos = -(W n) . p_view, multiplier +1 when cos >= 0.
-            const bool positive = -dot(w * axis, p_view) >= 0.0f;
+            const bool positive =
+                sees_positive_side(-dot(w * axis, p_view), length(p_view), dot(axis, rule.up), grazing_sine);
             out.positive_side[i] = positive ? 1 : 0;
             out.normal[i] = positive ? axis : -axis;
         }

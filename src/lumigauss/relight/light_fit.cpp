@@ -140,7 +140,7 @@ class FrozenViewObjective {
           mask_(mask.pixels.empty() ? Image(photo.width, photo.height, 1, 1.0f) : mask) {
         mode_ = o.shadowed ? ShadingMode::Shadowed : ShadingMode::Unshadowed;
         model_.activated(batch_);
-        compute_view_normals(model_, camera_, normals_);
+        compute_view_normals(model_, camera_, normals_, run.side_rule);
         shape_ = ImageShape{photo.width, photo.height, 3};
         // The geometry is frozen, so the blending weights of one rasterisation serve every step: each
         // evaluation only re-shades the surfels and composites with them (and back), which is exact.

@@ -192,7 +192,7 @@ RelightSummary run_relight_job(const RelightJob& job, const std::function<void(c
 
     const std::vector<double> angles =
         job.spin > 0 ? spin_angles(job.spin, job.rotate_degrees) : std::vector<double>{job.rotate_degrees};
-    RelitRenderer renderer(run.model, job.backend);
+    RelitRenderer renderer(run.model, job.backend, run.side_rule);
     for (const NamedCamera& nc : cams.cameras) {
         for (std::size_t k = 0; k < angles.size(); ++k) {
             const auto t0 = std::chrono::steady_clock::now();

@@ -13,8 +13,8 @@ namespace lumigauss {
 
 static_assert(kRelitChannels <= kMaxChannels, "the CPU rasterizer blends at most kMaxChannels channels");
 
-RelitRenderer::RelitRenderer(const SurfelModel& model, RasterBackend backend)
-    : model_(model), renderer_(backend) {
+RelitRenderer::RelitRenderer(const SurfelModel& model, RasterBackend backend, const SurfelSideRule& sides)
+    : model_(model), renderer_(backend, sides) {
     const std::size_t n = model.size();
     albedo_.resize(3 * n);
     for (std::size_t i = 0; i < n; ++i) {

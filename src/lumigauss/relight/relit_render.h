@@ -25,9 +25,11 @@ inline constexpr int kRelitShadowed = 0, kRelitUnshadowed = 3, kRelitIntensitySh
                      kRelitIntensityUnshadowed = 9, kRelitAlbedo = 12;
 
 // Renders one model from many cameras and environments, keeping the per-model albedo and the buffers.
+// `sides`: the run's side rule (TrainedRun::side_rule).
 class RelitRenderer {
   public:
-    explicit RelitRenderer(const SurfelModel& model, RasterBackend backend = RasterBackend::Cpu);
+    explicit RelitRenderer(const SurfelModel& model, RasterBackend backend = RasterBackend::Cpu,
+                           const SurfelSideRule& sides = {});
     // The raster output: color has kRelitChannels per pixel (layout above), unclamped.
     const RasterImages<float>& render(const Camera& camera, const ShCoeffs<float>& env);
 

@@ -103,6 +103,11 @@ struct TrainConfig {
     // of a new viewpoint then look like ground. Not with object masks (mask_mode "object"), whose outside is
     // empty space.
     bool ground_backdrop = false;
+    // A level surfel seen within this many degrees of its own plane shows its upper side (the photos' up)
+    // instead of the side facing the camera (shading/surfel_side.h): a few degrees of tilt in the fitted
+    // ground no longer shows far cameras its underside, shaded by the light from below. 0 = off, as
+    // officially. Saved with the run: every render of it (relight, eval, viewer) shades by the same rule.
+    double grazing_side_degrees = 0.0;
     // Where sky masks exist: alpha pushed to 0 on sky pixels (mean alpha over the sky mask eroded by
     // sky_mask_erosion pixels), the environment supervised by the sky pixels it must reproduce (L1 plus
     // 0.1 x (1 - cosine) per pixel, saturated pixels skipped), and the normal/distortion losses kept off the

@@ -384,7 +384,8 @@ StepReport Trainer::step() {
     report.view = view_for_iteration(it);
     last_view_ = report.view;
     if (stage == Stage::Shadowed && bakes_transfer(it)) bake_transfer();
-    compute_view_normals(state_.model, views_[std::size_t(report.view)].camera, scratch_->normals);
+    compute_view_normals(state_.model, views_[std::size_t(report.view)].camera, scratch_->normals,
+                         side_rule());
     if (stage != Stage::TransferFitting) render_step(it, stage, report);
     physical_step(it, stage, report);
     check_finite(it, report);

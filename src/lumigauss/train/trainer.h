@@ -133,6 +133,8 @@ class Trainer {
     // Where the sky drawn behind the surfels ends below the horizon (config sky_horizon_*; the cameras'
     // mean up), and the ground drawn there (config ground_backdrop: the current surfels' ground albedo).
     SkyHorizon sky_horizon() const;
+    // Which side of each surfel a camera sees (config grazing_side_degrees about the photos' up).
+    SurfelSideRule side_rule() const { return {up_, float(state_.config.grazing_side_degrees)}; }
     // How config geometric_transfer_every bakes the transfer (model/visibility_transfer.h): the ray start and
     // the ground's layer thickness as fractions of the scene extent, config shadow_bounce.
     VisibilityTransferOptions geometric_transfer_options() const;

@@ -226,7 +226,8 @@ Image preview_image(const Trainer& trainer, int v) {
     const TrainView& view = trainer.views()[std::size_t(v)];
     const TrainState& st = trainer.state();
     const ShCoeffs<float> env = trainer.environment(v);
-    RasterImages<float> img = render_with_environment(st.model, view.camera, env, ShadingMode::Both);
+    RasterImages<float> img = render_with_environment(st.model, view.camera, env, ShadingMode::Both,
+                                                      RasterBackend::Cpu, trainer.side_rule());
     if (st.config.sky_background) {
         const Sh4Coeffs<float> residual =
             st.sky_residuals.empty() ? Sh4Coeffs<float>{} : st.sky_residuals.get(v);

@@ -65,6 +65,7 @@ ViewerScene describe_scene(const TrainedRun& run, const std::vector<ResolvedLigh
     scene.camera = std::move(camera);
     scene.sky_background = run.sky_background;
     scene.sky_horizon = run.sky_horizon;
+    scene.side_rule = run.side_rule;
     model_extent(run.model, scene);
     for (const ResolvedLight& l : extra_lights)
         scene.lights.push_back({light_name(l), light_kind_name(l.kind), l.sh});
@@ -100,6 +101,10 @@ std::string scene_json(const ViewerScene& scene) {
                                                  {"fade_degrees", h.fade_degrees},
                                                  {"ground_albedo", vec_json(h.ground_albedo.cast<double>())}}
                                           : json(nullptr);
+    const SurfelSideRule& s = scene.side_rule;
+    j["side_rule"] = s.active()
+                         ? json{{"up", vec_json(s.up.cast<double>())}, {"grazing_degrees", s.grazing_degrees}}
+                         : json(nullptr);
     return j.dump();
 }
 

@@ -7,7 +7,8 @@
 //    "camera": null | {"width": W, "height": H, "fx": .., "fy": .., "cx": .., "cy": ..,
 //                      "R": [[..], [..], [..]], "t": [..]},          (cameras/camera_json.h conventions)
 //    "lights": [{"name": "IMG_0001.jpg", "kind": "training photo", "sh": [[R, G, B] x 9]}, ...],
-//    "initial_light": 0}
+//    "initial_light": 0, "sky_background": bool, "sky_horizon": null | {..},
+//    "side_rule": null | {"up": [x, y, z], "grazing_degrees": d}}   (shading/surfel_side.h; null: official)
 // Lights in order: those given with --light, then every training photo's learned lighting (embedding
 // order), then "uniform" (constant radiance with irradiance 1 everywhere, for inspecting albedo and
 // geometry). SH are radiance L_lm in the world frame (shading/sh.h order). up, e1, e2 form the right-handed
@@ -40,6 +41,7 @@ struct ViewerScene {
     std::vector<ViewerLight> lights;
     bool sky_background = false;  // the run was trained with its sky drawn behind the surfels
     SkyHorizon sky_horizon;       // where that sky ends below the horizon (no fade: nowhere)
+    SurfelSideRule side_rule;     // which side of a surfel a camera sees, as trained (TrainedRun's)
 };
 
 // The uniform environment: radiance 1 / pi in every direction, so irradiance(L, n) = 1 for every n.
