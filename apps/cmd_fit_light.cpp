@@ -176,7 +176,7 @@ void run_fit_light(FitLightOptions o) {
             render_with_environment(run.model, in.camera, r.sh.cast<float>(),
                                     o.fit.shadowed ? ShadingMode::Shadowed : ShadingMode::Unshadowed,
                                     RasterBackend::Cpu, run.side_rule);
-        write_png(o.render, fitted_colour(run, in.camera, img, 0, r.sh));
+        write_png(o.render, fitted_colour(run, in.camera, img, 0, r));
     }
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("fit-light: masked PSNR %.2f -> %.2f dB, l+ %.3g; wrote %s%s%s (%.1f s)\n", r.initial_psnr,

@@ -271,8 +271,11 @@ TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
             if (a.at(item.key()) != item.value()) differing.insert(item.key());
         std::set<std::string> expected = improvements;
         expected.insert("preset");
-        // Traced shadows: measured on the fast schedule only (train_preset).
-        if (std::string(improved) == "fast") expected.insert("geometric_transfer_every");
+        // Traced shadows, the free sky and the ground-light prior: measured on the fast schedule only
+        // (train_preset).
+        if (std::string(improved) == "fast")
+            expected.insert({"geometric_transfer_every", "sky_residual", "lambda_sky_residual",
+                             "sky_pins_light", "lambda_ground_light", "ground_light_albedo"});
         EXPECT_EQ(differing, expected);
         EXPECT_EQ(a.at("preset"), improved);
     }
@@ -291,6 +294,10 @@ TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
     EXPECT_FALSE(paper.ground_backdrop);
     EXPECT_FALSE(paper.ground_seeds);
     EXPECT_EQ(paper.grazing_side_degrees, 0.0);
+    EXPECT_EQ(paper.lambda_ground_light, 0.0);
+    EXPECT_TRUE(paper.sky_pins_light);
+    EXPECT_TRUE(train_preset("default").sky_pins_light);
+    EXPECT_FALSE(train_preset("fast").sky_pins_light);
 }
 
 TEST(TrainConfigPreset, EveryPresetValidates) {

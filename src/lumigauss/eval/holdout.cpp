@@ -55,12 +55,13 @@ HoldoutImageResult evaluate_view(const TrainedRun& run, const Dataset& scene, co
     p.truth = scene.load_image(view);
     const Image scene_mask = scene.load_mask(view);
     const Image fit_mask = holdout_fit_mask(scene_mask, w, h);
-    p.mask = holdout_score_mask(scene_mask, w, h);
+    p.mask = holdout_score_mask(scene_mask, w, h, scene.load_sky_mask(view));
     r.fit_pixels = mask_pixels(fit_mask);
     r.score_pixels = mask_pixels(p.mask);
     if (r.fit_pixels == 0) throw Error(view.image_path + ": holdout: the left half has no pixel to fit");
     if (r.score_pixels == 0)
-        throw Error(view.image_path + ": holdout: the right half has no fully covered pixel to score");
+        throw Error(view.image_path + ": holdout: the right half has no fully covered pixel to score" +
+                    (view.sky_mask_path.empty() ? "" : " outside the sky mask " + view.sky_mask_path));
 
     auto t0 = Clock::now();
     LightFitOptions fit_options = options.fit;
@@ -68,20 +69,21 @@ HoldoutImageResult evaluate_view(const TrainedRun& run, const Dataset& scene, co
     const LightFitResult fit = fit_light(run, view.camera, p.truth, fit_mask, fit_options);
     r.fit_psnr = fit.final_psnr;
     r.light = fit.sh;
+    LightFitResult fit_unshadowed;
     if (options.unshadowed) {
         fit_options.shadowed = false;
-        const LightFitResult fit_unshadowed = fit_light(run, view.camera, p.truth, fit_mask, fit_options);
+        fit_unshadowed = fit_light(run, view.camera, p.truth, fit_mask, fit_options);
         r.fit_psnr_unshadowed = fit_unshadowed.final_psnr;
         r.light_unshadowed = fit_unshadowed.sh;
     }
     r.fit_ms = ms_since(t0) / (options.unshadowed ? 2 : 1);
 
     // The unshadowed colour under its own light first; then everything else under the shadowed fit.
-    // Each drawn as the fit saw it: over its light's sky when the run was trained with its sky behind.
+    // Each drawn as the fit saw it: over its fitted sky when the run was trained with its sky behind.
     if (options.unshadowed) {
         p.unshadowed =
             fitted_colour(run, view.camera, renderer.render(view.camera, r.light_unshadowed.cast<float>()),
-                          kRelitUnshadowed, r.light_unshadowed);
+                          kRelitUnshadowed, fit_unshadowed);
         r.unshadowed = image_metrics(p.unshadowed, p.truth, p.mask, options.ssim);
     } else {
         const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -91,7 +93,7 @@ HoldoutImageResult evaluate_view(const TrainedRun& run, const Dataset& scene, co
     t0 = Clock::now();
     const RasterImages<float>& relit = renderer.render(view.camera, fit.sh.cast<float>());
     r.render_ms = ms_since(t0);
-    p.shadowed = fitted_colour(run, view.camera, relit, kRelitShadowed, fit.sh);
+    p.shadowed = fitted_colour(run, view.camera, relit, kRelitShadowed, fit);
     r.shadowed = image_metrics(p.shadowed, p.truth, p.mask, options.ssim);
     if (options.keep_panels) {
         p.albedo = clamp01(raster_channels(relit, kRelitAlbedo, 3));
@@ -110,8 +112,14 @@ Image holdout_fit_mask(const Image& scene_mask, int width, int height) {
     return keep_columns(mask_or_ones(scene_mask, width, height), 0, width / 2);
 }
 
-Image holdout_score_mask(const Image& scene_mask, int width, int height) {
-    const Image binary = binarize_mask(mask_or_ones(scene_mask, width, height), 0.5f);
+Image holdout_score_mask(const Image& scene_mask, int width, int height, const Image& sky_mask) {
+    Image binary = binarize_mask(mask_or_ones(scene_mask, width, height), 0.5f);
+    if (!sky_mask.empty()) {
+        if (sky_mask.width != width || sky_mask.height != height || sky_mask.channels != 1)
+            throw Error("holdout: the sky mask is not one channel of the image's size");
+        for (std::size_t p = 0; p < binary.pixels.size(); ++p)
+            if (sky_mask.pixels[p] >= 0.5f) binary.pixels[p] = 0.0f;
+    }
     return keep_columns(official_eval_mask(binary), width / 2, width);
 }
 

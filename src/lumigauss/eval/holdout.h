@@ -7,8 +7,11 @@
 //
 //   fit mask    the scene's mask (soft values as stored; all ones without one) on columns x < W/2
 //   score mask  official_eval_mask (io/image_metrics.h: 5x5 erosion, fully covered pixels) of the scene's
-//   mask
-//               binarised at 0.5, on columns x >= W/2
+//               mask binarised at 0.5 less the view's sky mask (when the scene has one), on columns x >= W/2
+// The sky is left out of the score as NeRF-OSR's evaluation masks leave it out (and gt-env's gt/mask): a
+// sky is not relit geometry, and a run whose sky is a per-photo residual free of its light (config
+// sky_pins_light=false) can only extrapolate the right half's sky from the left's. The fit still sees the
+// left half's sky as training saw its photos' skies.
 // Each render is scored under its own fit: the shadowed render under the light fitted to the shadowed render,
 // the unshadowed one under the light fitted to the unshadowed render, so that neither is judged with a
 // light tuned for the other (an unshadowed model compensates missing shadows with a dimmer light).
@@ -69,7 +72,8 @@ struct HoldoutResult {
 
 // Fit mask and score mask of a view (see above) from the scene's mask as loaded (empty: no mask).
 Image holdout_fit_mask(const Image& scene_mask, int width, int height);
-Image holdout_score_mask(const Image& scene_mask, int width, int height);
+// `sky_mask` (empty, or 1 channel of the image's size, 1 = sky) is taken out of the score mask.
+Image holdout_score_mask(const Image& scene_mask, int width, int height, const Image& sky_mask = {});
 
 // Runs the protocol on the views of `scene` (loaded at the resolution to evaluate). Throws Error naming
 // the image when a half has no pixel to fit or to score.

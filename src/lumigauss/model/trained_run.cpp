@@ -140,6 +140,10 @@ TrainedRun load_trained_run(const std::string& dir) {
             run.downscale = c["downscale"].get<int>();
         if (c.is_object() && c.contains("sky_background") && c["sky_background"].is_boolean())
             run.sky_background = c["sky_background"].get<bool>();
+        if (c.is_object() && c.contains("sky_pins_light") && c["sky_pins_light"].is_boolean())
+            run.sky_pins_light = c["sky_pins_light"].get<bool>();
+        if (c.is_object() && c.contains("lambda_sky_residual") && c["lambda_sky_residual"].is_number())
+            run.lambda_sky_residual = std::max(0.0, c["lambda_sky_residual"].get<double>());
         run.sky_horizon = recorded_sky_horizon(c, run.photos_up);
         run.side_rule = recorded_side_rule(c, run.photos_up);
         const bool object_masks = c.is_object() && c.contains("mask_mode") && c["mask_mode"].is_string() &&

@@ -23,6 +23,7 @@ namespace lumigauss {
 namespace {
 
 constexpr int kShFloats = 3 * kShCount;
+constexpr int kResidualFloats = 3 * kSh4Count;
 
 // Flat k * 3 + channel layout for the optimizer.
 void to_flat(const ShCoeffs<float>& sh, std::span<float> flat) {
@@ -35,6 +36,18 @@ ShCoeffs<float> from_flat(std::span<const float> flat) {
     for (int k = 0; k < kShCount; ++k)
         for (int c = 0; c < 3; ++c) sh.c[k][c] = flat[std::size_t(3 * k + c)];
     return sh;
+}
+
+Sh4Coeffs<float> residual_from_flat(std::span<const float> flat) {
+    Sh4Coeffs<float> r;
+    for (int k = 0; k < kSh4Count; ++k)
+        for (int c = 0; c < 3; ++c) r.c[k][c] = flat[std::size_t(3 * k + c)];
+    return r;
+}
+
+void residual_to_flat(const Sh4Coeffs<float>& r, std::span<float> flat) {
+    for (int k = 0; k < kSh4Count; ++k)
+        for (int c = 0; c < 3; ++c) flat[std::size_t(3 * k + c)] = r.c[k][c];
 }
 
 std::vector<float> mean_embedding(const LightingMlp& mlp) {
@@ -126,9 +139,36 @@ class LightParameters {
     LightingForward<float> forward_;
 };
 
-// One render of the frozen model under a light, its objective and the objective's gradient w.r.t. the SH.
-// A run trained with its sky behind the surfels is rendered so here too: the sky of the light being fitted
-// fills what the surfels leave uncovered, and its pixels pull on the light as they did in training.
+// The photo's own sky residual, fitted beside the light when the run learned one per training photo: Adam
+// from zero, the learning rate and decay of the SH.
+class SkyResidualParameter {
+  public:
+    SkyResidualParameter(bool active, const LightFitOptions& o)
+        : values_(active ? kResidualFloats : 0, 0.0f), grads_(values_.size(), 0.0f) {
+        if (active) adam_ = AdamGroup("sky_residual", values_.size(), o.sh_learning_rate, 1, 1e-15);
+        base_lr_ = o.sh_learning_rate;
+    }
+    bool active() const { return !values_.empty(); }
+    Sh4Coeffs<float> value() const { return active() ? residual_from_flat(values_) : Sh4Coeffs<float>{}; }
+    void set_gradient(const Sh4Coeffs<float>& g) {
+        if (active()) residual_to_flat(g, grads_);
+    }
+    void step(double lr_factor) {
+        if (!active()) return;
+        adam_.set_lr(base_lr_ * lr_factor);
+        adam_.step(values_, grads_);
+    }
+
+  private:
+    std::vector<float> values_, grads_;
+    AdamGroup adam_;
+    double base_lr_ = 0;
+};
+
+// One render of the frozen model under a light, its objective and the objective's gradient w.r.t. the SH
+// (and the sky residual). A run trained with its sky behind the surfels is rendered so here too: the sky of
+// the light being fitted (plus the photo's residual, when the run has them) fills what the surfels leave
+// uncovered, and its pixels pull on the light only if they did in training (TrainedRun::sky_pins_light).
 class FrozenViewObjective {
   public:
     FrozenViewObjective(const TrainedRun& run, const Camera& camera, const Image& photo, const Image& mask,
@@ -149,20 +189,28 @@ class FrozenViewObjective {
         if (run.sky_background) {
             rays_ = pixel_ray_directions(camera_);
             horizon_ = run.sky_horizon;
+            sky_pins_light_ = run.sky_pins_light;
+            with_residual_ = !run.sky_residuals.empty();
+            lambda_residual_ = run.lambda_sky_residual;
         }
     }
+
+    // Whether the photo gets a sky residual of its own.
+    bool fits_sky_residual() const { return with_residual_; }
 
     struct Value {
         double loss = 0, psnr = 0;
         ShCoeffs<float> g_env{};
+        Sh4Coeffs<float> g_residual{};
     };
 
-    Value evaluate(const ShCoeffs<float>& env, int iteration, bool with_gradient) {
+    Value evaluate(const ShCoeffs<float>& env, const Sh4Coeffs<float>& residual, int iteration,
+                   bool with_gradient) {
         Value v;
         shade_surfels(model_, env, mode_, normals_, batch_);
         composite(weights_, batch_.colors, batch_.channels, images_.color);
         if (!rays_.empty()) {
-            sky_pixels(rays_, env, nullptr, sky_, horizon_);
+            sky_pixels(rays_, env, with_residual_ ? &residual : nullptr, sky_, horizon_);
             composite_background<float>(images_, sky_.colour, 0);
         }
         std::span<const float> rendered = images_.color;  // 3 channels in either single mode
@@ -175,8 +223,17 @@ class FrozenViewObjective {
         const double env_loss = env_nonnegativity_loss(env, o_.env_samples, o_.seed, iteration,
                                                        with_gradient ? o_.lambda_env : 0.0, v.g_env);
         v.loss = w1 * l1 + w2 * dssim + o_.lambda_env * env_loss;
+        if (with_residual_) {
+            // As training: the residual only takes what the light cannot hold.
+            double penalty = 0;
+            for (int k = 0; k < kSh4Count; ++k) {
+                penalty += double(dot(residual.c[k], residual.c[k]));
+                v.g_residual.c[k] = float(2 * lambda_residual_) * residual.c[k];
+            }
+            v.loss += lambda_residual_ * penalty;
+        }
         v.psnr = fitted_psnr();
-        if (with_gradient) add_render_gradient(env, v.g_env);
+        if (with_gradient) add_render_gradient(env, v);
         return v;
     }
 
@@ -193,12 +250,16 @@ class FrozenViewObjective {
     }
 
   private:
-    void add_render_gradient(const ShCoeffs<float>& env, ShCoeffs<float>& g_env) {
+    void add_render_gradient(const ShCoeffs<float>& env, Value& v) {
+        ShCoeffs<float>& g_env = v.g_env;
         if (!rays_.empty()) {
             g_sky_.assign(sky_.colour.size(), 0.0f);
             composite_background_backward<float>(images_, sky_.colour, 0, grad_, g_sky_);
-            const SkyGrads g = sky_pixels_backward(rays_, sky_, g_sky_, {}, false);
-            for (int k = 0; k < kShCount; ++k) g_env.c[k] = g_env.c[k] + g.env.c[k];
+            const SkyGrads g = sky_pixels_backward(rays_, sky_, g_sky_, {}, with_residual_);
+            if (sky_pins_light_)
+                for (int k = 0; k < kShCount; ++k) g_env.c[k] = g_env.c[k] + g.env.c[k];
+            if (with_residual_)
+                for (int k = 0; k < kSh4Count; ++k) v.g_residual.c[k] = v.g_residual.c[k] + g.residual.c[k];
         }
         g_colors_.resize(batch_.colors.size());
         composite_backward(weights_, grad_.color, batch_.channels, g_colors_);
@@ -229,6 +290,8 @@ class FrozenViewObjective {
     std::vector<float> g_colors_;
     std::vector<Vec3f> rays_;  // every pixel's world ray, when the sky is drawn behind; else empty
     SkyHorizon horizon_;
+    bool sky_pins_light_ = true, with_residual_ = false;
+    double lambda_residual_ = 0;
     SkyPixels sky_;
     std::vector<float> g_sky_;
 };
@@ -240,12 +303,17 @@ const char* light_variable_name(LightVariable v) {
 }
 
 Image fitted_colour(const TrainedRun& run, const Camera& camera, const RasterImages<float>& relit, int first,
-                    const ShCoeffs<double>& light) {
+                    const ShCoeffs<double>& light, const Sh4Coeffs<float>* sky_residual) {
     Image colour = raster_channels(relit, first, 3);
     if (run.sky_background)
         colour = over_background_image(colour, alpha_image(relit),
-                                       sky_image(camera, light.cast<float>(), nullptr, run.sky_horizon));
+                                       sky_image(camera, light.cast<float>(), sky_residual, run.sky_horizon));
     return clamp01(colour);
+}
+
+Image fitted_colour(const TrainedRun& run, const Camera& camera, const RasterImages<float>& relit, int first,
+                    const LightFitResult& fit) {
+    return fitted_colour(run, camera, relit, first, fit.sh, fit.sky_residual ? &*fit.sky_residual : nullptr);
 }
 
 ShCoeffs<double> default_initial_sh(const TrainedRun& run) {
@@ -264,22 +332,25 @@ LightFitResult fit_light(const TrainedRun& run, const Camera& camera, const Imag
     check_inputs(run, camera, photo, mask, options);
     LightParameters light(run, options);
     FrozenViewObjective objective(run, camera, photo, mask, options);
+    SkyResidualParameter residual(objective.fits_sky_residual(), options);
 
     // The best iterate so far: its parameters, its light and its scores (the loss and PSNR evaluate() gave
     // for those parameters, before the step that followed).
     struct Iterate {
         std::vector<float> values;
         ShCoeffs<float> env{};
+        Sh4Coeffs<float> residual{};
         double loss = std::numeric_limits<double>::infinity(), psnr = 0;
     } best;
     const auto keep_if_best = [&](const ShCoeffs<float>& env, double loss, double psnr) {
-        if (std::isfinite(loss) && loss < best.loss) best = {light.values(), env, loss, psnr};
+        if (std::isfinite(loss) && loss < best.loss)
+            best = {light.values(), env, residual.value(), loss, psnr};
     };
     LightFitResult result;
     const double decay = std::log(options.final_lr_fraction);
     for (int it = 0; it < options.iterations; ++it) {
         const ShCoeffs<float> env = light.sh();
-        const auto v = objective.evaluate(env, it, true);
+        const auto v = objective.evaluate(env, residual.value(), it, true);
         if (!std::isfinite(v.loss))
             throw Error("fit-light: the objective became non-finite at iteration " + std::to_string(it));
         if (it == 0) {
@@ -290,14 +361,18 @@ LightFitResult fit_light(const TrainedRun& run, const Camera& camera, const Imag
         keep_if_best(env, v.loss, v.psnr);
         if (options.progress) options.progress(it, v.loss, v.psnr);
         light.set_gradient(v.g_env);
-        light.step(std::exp(decay * it / std::max(1, options.iterations - 1)));
+        residual.set_gradient(v.g_residual);
+        const double lr_factor = std::exp(decay * it / std::max(1, options.iterations - 1));
+        light.step(lr_factor);
+        residual.step(lr_factor);
     }
     // The last step's result has not been scored yet.
     const ShCoeffs<float> last = light.sh();
-    const auto v = objective.evaluate(last, options.iterations, false);
+    const auto v = objective.evaluate(last, residual.value(), options.iterations, false);
     keep_if_best(last, v.loss, v.psnr);
 
     result.sh = best.env.cast<double>();
+    if (residual.active()) result.sky_residual = best.residual;
     if (options.variable == LightVariable::Embedding) result.embedding = best.values;
     result.iterations = options.iterations;
     result.final_loss = best.loss;

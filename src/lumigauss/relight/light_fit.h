@@ -12,6 +12,10 @@
 //   * Embedding: a new 24-float embedding through the run's frozen lighting MLP (the NeRF-W way to fit the
 //     appearance of a test photo). The light stays on the manifold of lights seen in training, which is
 //     more robust when only part of the photo is seen (holdout). Starts from the mean training embedding.
+// A run trained with its sky behind the surfels is fitted as it was trained: the sky of the light fills what
+// the surfels leave uncovered; when the run learned a sky residual per photo, the photo gets one too (from
+// zero, under the run's L2 weight), and when its sky did not shape its lights (config sky_pins_light=false)
+// the sky's pixels move that residual only, so that the light is the surfels' alone.
 // The geometry and the transfer functions are fixed, so the visibility of every pixel is computed once:
 // each iteration re-shades the surfels, re-rasterises and back-propagates only to the light.
 //
@@ -26,6 +30,7 @@
 #include "lumigauss/io/image.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/shading/sh.h"
+#include "lumigauss/shading/sh_degree4.h"
 
 namespace lumigauss {
 
@@ -52,7 +57,10 @@ struct LightFitOptions {
 };
 
 struct LightFitResult {
-    ShCoeffs<double> sh;           // the fitted environment radiance SH (world frame)
+    ShCoeffs<double> sh;  // the fitted environment radiance SH (world frame)
+    // The photo's fitted sky residual, when the run has them (TrainedRun::sky_residuals): its sky is drawn
+    // from sh plus this.
+    std::optional<Sh4Coeffs<float>> sky_residual;
     std::vector<float> embedding;  // Embedding: the fitted embedding; empty for Sh
     int iterations = 0;
     double initial_loss = 0, final_loss = 0;  // objective above, at the start and at the result
@@ -68,10 +76,13 @@ LightFitResult fit_light(const TrainedRun& run, const Camera& camera, const Imag
                          const LightFitOptions& options);
 
 // Channels [first, first + 3) of a render (`relit`: relit_render.h's layout, or any colour raster with
-// first = 0) as the fit compares it with the photo: over the sky of `light` when the run was trained with its
-// sky behind the surfels (else over black), clamped to [0, 1].
+// first = 0) as the fit compares it with the photo: over the sky of `light` (plus `sky_residual`, when given)
+// when the run was trained with its sky behind the surfels (else over black), clamped to [0, 1].
 Image fitted_colour(const TrainedRun& run, const Camera& camera, const RasterImages<float>& relit, int first,
-                    const ShCoeffs<double>& light);
+                    const ShCoeffs<double>& light, const Sh4Coeffs<float>* sky_residual = nullptr);
+// The same under a fit's light and sky.
+Image fitted_colour(const TrainedRun& run, const Camera& camera, const RasterImages<float>& relit, int first,
+                    const LightFitResult& fit);
 
 // The default starting light: the mean learned SH of the run's photos, or a neutral grey environment with
 // irradiance 1 in every direction when the run has none (a bare PLY).

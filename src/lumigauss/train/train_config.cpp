@@ -435,6 +435,19 @@ TrainConfig train_preset(std::string_view name) {
     // all, albedo up to 2 dB better). Not in `default` yet: its one run so far, on the demo temple, lost 1.3
     // dB with it (the long shadowed stage darkened the building), and plaza is not measured.
     if (name == "fast") config.geometric_transfer_every = 500;
+    // The sky's pixels shape the sky's own residual, not the light (a degree-2 light cannot draw a sky with a
+    // sun: pinned to the sky, the lights lost their direction), and the light from below is pulled towards
+    // the reflection of a ground of albedo 0.2 (the usual outdoor ground; without it the free light grew a
+    // bright floor). With the grazing rule, three seeds on three scenes (bench/RESULTS.md, sessions 36-37):
+    // shadowed gt-env PSNR up on every scene, the learned lights nearer the true ones (direction strength
+    // 0.36-0.45 -> 0.55-0.77). Measured on the fast schedule only, as the traced shadows it goes with.
+    if (name == "fast") {
+        config.sky_residual = true;
+        config.lambda_sky_residual = 0.0;
+        config.sky_pins_light = false;
+        config.lambda_ground_light = 1.0;
+        config.ground_light_albedo = 0.2;
+    }
     if (name == "paper-fast" || name == "fast" || name == "default") {
         config.preset = std::string(name);
         return config;

@@ -88,6 +88,11 @@ bool uses_sky_residual(const TrainConfig& c) {
     return c.sky_background && c.sky_residual;
 }
 
+// The ground is drawn below the sky's horizon (an object mask's outside is empty space, the ground included).
+bool draws_ground_backdrop(const TrainConfig& c) {
+    return c.ground_backdrop && c.mask_mode != "object";
+}
+
 // Deinterleaves channels [first, first + 3) of an image with `channels` values per pixel.
 void extract_rgb(const std::vector<float>& src, int channels, int first, std::vector<float>& dst) {
     const std::size_t pixels = src.size() / std::size_t(channels);
@@ -326,11 +331,13 @@ void Trainer::prepare_view_masks() {
 }
 
 SkyHorizon Trainer::sky_horizon() const {
+    return sky_horizon(draws_ground_backdrop(state_.config) ? ground_albedo(state_.model, up_) : Vec3f{});
+}
+
+SkyHorizon Trainer::sky_horizon(const Vec3f& ground) const {
     const TrainConfig& c = state_.config;
     SkyHorizon horizon{up_, float(c.sky_horizon_start), float(c.sky_horizon_fade)};
-    // An object mask's outside is empty space, the ground included.
-    if (c.ground_backdrop && c.mask_mode != "object")
-        horizon.ground_albedo = ground_albedo(state_.model, up_);
+    if (draws_ground_backdrop(c)) horizon.ground_albedo = ground;
     return horizon;
 }
 
@@ -403,6 +410,10 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     GaussianModel& model = state_.model;
 
     auto t0 = Clock::now();
+    // A weighted median over every surfel: made once per step for the sky's ground backdrop and the
+    // ground-light prior.
+    const bool needs_ground = (c.sky_background && draws_ground_backdrop(c)) || c.lambda_ground_light > 0;
+    const Vec3f ground = needs_ground ? ground_albedo(model, up_) : Vec3f{};
     const LightingForward<float> env_pass = state_.lighting.forward(report.view);
     // The photo's environment: its exposure (1 unless exif_exposure) x the network's output.
     const float exposure = exposure_[std::size_t(report.view)];
@@ -427,7 +438,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     if (residual) sky_residual = state_.sky_residuals.get(report.view);
     if (c.sky_background) {
         s.rays = pixel_ray_directions(view.camera);
-        sky_pixels(s.rays, env, residual ? &sky_residual : nullptr, s.sky, sky_horizon());
+        sky_pixels(s.rays, env, residual ? &sky_residual : nullptr, s.sky, sky_horizon(ground));
         for (int first : colour_sets) composite_background<float>(s.images, s.sky.colour, first);
     }
     times_.raster_forward += seconds_since(t0);
@@ -530,7 +541,7 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
     report.env = env_nonnegativity_loss(clean, c.env_samples, c.seed, it, c.lambda_env, g_env);
     report.total += c.lambda_env * report.env;
     if (c.lambda_ground_light > 0) {
-        const Vec3d reflectance = ground_reflectance(ground_albedo(state_.model, up_), c.ground_light_albedo);
+        const Vec3d reflectance = ground_reflectance(ground, c.ground_light_albedo);
         report.ground_light = ground_light_prior(clean, up_, reflectance, c.lambda_ground_light, g_env);
         report.total += c.lambda_ground_light * report.ground_light;
     }

@@ -152,6 +152,8 @@ class Trainer {
     const LightingMlpGradients& lighting_gradients() const { return lighting_grads_; }
 
   private:
+    // sky_horizon() with the ground albedo already made.
+    SkyHorizon sky_horizon(const Vec3f& ground) const;
     struct Scratch;
     struct ViewMasks;
     void prepare_view_masks();
