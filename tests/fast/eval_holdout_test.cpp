@@ -49,6 +49,15 @@ TEST(HoldoutMasks, LeftHalfFitsRightHalfScores) {
     EXPECT_EQ(score.at(7, 1, 0), 1.0f);
     EXPECT_EQ(score.at(9, 7, 0), 1.0f);
     EXPECT_EQ(score.at(5, 0, 0), 1.0f);
+    // A sky mask takes the sky out of the score, eroded like the rest (NeRF-OSR's evaluation masks).
+    Image sky(10, 8, 1, 0.0f);
+    sky.at(9, 0, 0) = 1.0f;
+    const Image no_sky = holdout_score_mask(scene_mask, 10, 8, sky);
+    EXPECT_EQ(no_sky.at(9, 0, 0), 0.0f);
+    EXPECT_EQ(no_sky.at(7, 1, 0), 0.0f);  // within 2 of the sky
+    EXPECT_EQ(no_sky.at(5, 0, 0), 1.0f);
+    EXPECT_EQ(no_sky.at(9, 7, 0), 1.0f);
+    EXPECT_THROW(holdout_score_mask(scene_mask, 10, 8, Image(9, 8, 1, 0.0f)), Error);
     // Without a scene mask: all ones, split the same way.
     const Image none = holdout_fit_mask(Image{}, 10, 8);
     EXPECT_EQ(none.at(4, 3, 0), 1.0f);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "lumigauss/io/image_metrics.h"
 #include "lumigauss/model/render_model.h"
 #include "lumigauss/model/view_shading.h"
 #include "lumigauss/relight/light_fit.h"
@@ -152,6 +153,51 @@ TEST(LightFit, ASkyBackgroundRunFitsTheSkyBehindTheSurfels) {
     // The same photo fitted as if the run had no sky: its sky pixels stay black and the fit cannot match.
     run.sky_background = false;
     EXPECT_LT(fit_light(run, cam, photo, Image{}, o).final_psnr, 25.0);
+}
+
+// A run whose sky was a per-photo residual free of its lights (sky_pins_light=false) is fitted so: the
+// photo's sky, here its light's sky plus a residual, moves the photo's own residual and not the light, which
+// the surfels alone decide. Started at the true light, the light stays there and the residual takes the sky;
+// when the sky pulls on the light as well (a run whose sky pins its lights), the light is bent off it.
+TEST(LightFit, AFreeSkyMovesItsResidualNotTheLight) {
+    const Camera cam = testing::test_camera(64, 56);
+    TrainedRun run = in_memory_run(random_model(cam, 8, 40), {});
+    run.sky_background = true;
+    run.sky_residuals = SkyResiduals(1);
+    run.sky_pins_light = false;
+    const ShCoeffs<double> truth = true_light(14);
+    Sh4Coeffs<float> residual{};
+    residual.c[0] = {0.3f, 0.1f, -0.1f};
+    residual.c[2] = {-0.2f, 0.1f, 0.25f};
+    residual.c[12] = {0.15f, -0.1f, 0.1f};
+    const RasterImages<float> raster =
+        render_with_environment(run.model, cam, truth.cast<float>(), ShadingMode::Shadowed);
+    const Image photo = fitted_colour(run, cam, raster, 0, truth, &residual);
+    std::size_t uncovered = 0;
+    for (float a : raster.alpha) uncovered += a < 0.5f;
+    ASSERT_GT(uncovered, raster.alpha.size() / 5) << "the sky must matter";
+    LightFitOptions o;
+    o.iterations = 300;
+    o.initial_sh = truth;
+    const LightFitResult r = fit_light(run, cam, photo, Image{}, o);
+    ASSERT_TRUE(r.sky_residual.has_value());
+    EXPECT_GT(r.final_psnr, 35.0);
+    EXPECT_LT(relative_error(r.sh, truth), 0.02);
+    // The residual the fit drew is the sky of the photo, so the fit's own colour is the photo.
+    EXPECT_GT(psnr_from_mse(masked_mse(fitted_colour(run, cam, raster, 0, r), photo, Image(64, 56, 1, 1.0f))),
+              35.0);
+    // The sky pulling on the light too: the light leaves the truth (0.045 against 0.014 when written; Adam
+    // steps a light at its optimum by the learning rate, so the free light is not exactly still).
+    run.sky_pins_light = true;
+    const LightFitResult pinned = fit_light(run, cam, photo, Image{}, o);
+    EXPECT_GT(relative_error(pinned.sh, truth), 2 * relative_error(r.sh, truth));
+    // No residual and a free sky: nothing can draw the photo's sky, and the light still stays.
+    run.sky_pins_light = false;
+    run.sky_residuals = SkyResiduals();
+    const LightFitResult bare = fit_light(run, cam, photo, Image{}, o);
+    EXPECT_FALSE(bare.sky_residual.has_value());
+    EXPECT_LT(relative_error(bare.sh, truth), 0.02);
+    EXPECT_LT(bare.final_psnr, r.final_psnr - 5.0);
 }
 
 TEST(LightFit, RecoversANetworkLightThroughTheEmbedding) {
