@@ -181,6 +181,13 @@ void run_fit_light(FitLightOptions o) {
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("fit-light: masked PSNR %.2f -> %.2f dB, l+ %.3g; wrote %s%s%s (%.1f s)\n", r.initial_psnr,
                 r.final_psnr, r.env_loss, out.c_str(), o.render.empty() ? "" : " and ", o.render.c_str(), s);
+    if (r.sky_residual && !o.quiet)
+        std::printf(
+            "fit-light: the run draws each photo's sky with a residual of its own (%s); the photo's is "
+            "fitted but not written, so `render --light %s` shows the light's own sky%s\n",
+            run.paths.sky.c_str(), out.c_str(),
+            run.sky_pins_light ? ""
+                               : " (the light itself is fitted to the surfels alone: sky_pins_light=false)");
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include "lumigauss/relight/light_fit.h"
 #include "lumigauss/shading/sh_text.h"
 #include "support/run_cli.h"
+#include "support/shared_tiny_run.h"
 #include "synth_test_util.h"
 
 namespace lumigauss {
@@ -94,6 +95,33 @@ TEST(CliFitLight, FitsATestPhotoByCameraName) {
     ASSERT_TRUE(fs::exists(render));
     const ShCoeffs<double> fitted = read_sh_text(out);
     EXPECT_GT(s.psnr_with(fitted), 40.0);
+}
+
+// A `fast` run's skies are residuals free of its lights: the fit says that the photo's residual is not in
+// the light file and that the light comes from the surfels alone.
+TEST(CliFitLight, SaysWhenTheRunsSkyIsFreeOfItsLight) {
+    const testing::SharedTinyRun& tiny = testing::shared_tiny_run();
+    ASSERT_EQ(tiny.exit_code, 0) << tiny.output;
+    TempDir tmp("cli_fit_light_free_sky");
+    const std::string out = tmp / "fitted.txt";
+    const CommandResult r =
+        run_lumigauss("fit-light " + shell_quoted(tiny.run) + " --scene " + shell_quoted(tiny.scene) +
+                          " --camera test_0000.png --iterations 10 -o " + shell_quoted(out),
+                      tmp);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("is fitted but not written"));
+    EXPECT_THAT(r.output, HasSubstr("sky_pins_light=false"));
+    EXPECT_TRUE(fs::exists(out));
+    // The run the other tests train has no residual: nothing to say.
+    const FitSetup& s = setup();
+    ASSERT_EQ(s.train.exit_code, 0) << s.train.output;
+    const CommandResult pinned =
+        run_lumigauss("fit-light " + shell_quoted(s.run) + " --scene " + shell_quoted(s.scene) +
+                          " --camera " + shell_quoted(s.view.name) + " --image " + shell_quoted(s.photo) +
+                          " --iterations 10 -o " + shell_quoted(tmp / "pinned.txt"),
+                      tmp);
+    ASSERT_EQ(pinned.exit_code, 0) << pinned.output;
+    EXPECT_THAT(pinned.output, ::testing::Not(HasSubstr("is fitted but not written")));
 }
 
 TEST(CliFitLight, FitsThroughTheEmbeddingWithACameraJson) {
