@@ -171,6 +171,21 @@ TEST(RelightTrainedRun, NamesTheMissingOrInconsistentFile) {
         c << "{ not json";
     }
     EXPECT_THAT(message_of([&] { load_trained_run(dir); }), HasSubstr("config.json"));
+    // A key of the wrong type is a damaged file, not a missing key (which older runs have).
+    for (const char* bad : {"{\"sky_pins_light\": \"no\"}", "{\"sky_horizon_fade\": \"4\"}",
+                            "{\"downscale\": 1.5}", "{\"mask_mode\": 1}", "[1, 2]"}) {
+        std::ofstream(run_paths(dir).config) << bad;
+        const std::string msg = message_of([&] { load_trained_run(dir); });
+        EXPECT_THAT(msg, HasSubstr("config.json")) << bad;
+        EXPECT_THAT(msg, ::testing::AnyOf(HasSubstr("must be"), HasSubstr("not a JSON object"))) << bad;
+    }
+    // Whether the sky shaped the lights, and the residuals' weight: recorded, else the older runs' behaviour.
+    std::ofstream(run_paths(dir).config) << "{\"sky_pins_light\": false, \"lambda_sky_residual\": 0.25}";
+    EXPECT_FALSE(load_trained_run(dir).sky_pins_light);
+    EXPECT_EQ(load_trained_run(dir).lambda_sky_residual, 0.25);
+    std::ofstream(run_paths(dir).config) << "{}";
+    EXPECT_TRUE(load_trained_run(dir).sky_pins_light);
+    EXPECT_EQ(load_trained_run(dir).lambda_sky_residual, 0.0);
     fs::remove(run_paths(dir).config);
     EXPECT_NO_THROW(load_trained_run(dir));
     for (const char* f : {"model.ply", "lighting.lgmlp", "appearance.json"}) {

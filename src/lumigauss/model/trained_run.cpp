@@ -47,16 +47,56 @@ std::optional<Vec3d> photos_up_of(const RecordedTrainingCameras& cameras) {
     return up;
 }
 
+// config.json as the run wrote it. Every key is optional (a run of an older version lacks the newer ones),
+// but a key that is there must have its type: anything else is a damaged or hand-edited file, named in the
+// error rather than read as if the key were missing.
+class RecordedConfig {
+  public:
+    explicit RecordedConfig(const std::string& path) : path_(path) {
+        json_ = nlohmann::json::parse(read_text_file(path), nullptr, false);
+        if (json_.is_discarded()) fail_in_file(path, "not valid JSON");
+        if (!json_.is_object())
+            fail_in_file(path, "not a JSON object (a run's config.json holds its settings)");
+    }
+    std::optional<double> number(const char* key) const {
+        const nlohmann::json* v = find(key);
+        if (v && !v->is_number()) wrong_type(key, "a number");
+        return v ? std::optional<double>(v->get<double>()) : std::nullopt;
+    }
+    std::optional<int> integer(const char* key) const {
+        const nlohmann::json* v = find(key);
+        if (v && !v->is_number_integer()) wrong_type(key, "an integer");
+        return v ? std::optional<int>(v->get<int>()) : std::nullopt;
+    }
+    std::optional<bool> flag(const char* key) const {
+        const nlohmann::json* v = find(key);
+        if (v && !v->is_boolean()) wrong_type(key, "true or false");
+        return v ? std::optional<bool>(v->get<bool>()) : std::nullopt;
+    }
+    std::optional<std::string> text(const char* key) const {
+        const nlohmann::json* v = find(key);
+        if (v && !v->is_string()) wrong_type(key, "a string");
+        return v ? std::optional<std::string>(v->get<std::string>()) : std::nullopt;
+    }
+
+  private:
+    const nlohmann::json* find(const char* key) const {
+        const auto it = json_.find(key);
+        return it == json_.end() ? nullptr : &*it;
+    }
+    [[noreturn]] void wrong_type(const char* key, const char* expected) const {
+        fail_in_file(path_, std::string("\"") + key + "\" must be " + expected);
+    }
+    std::string path_;
+    nlohmann::json json_;
+};
+
 // The horizon the run was trained with (Trainer::sky_horizon): the config's angles about the up of the
 // training photos. None when either is missing.
-SkyHorizon recorded_sky_horizon(const nlohmann::json& config, const std::optional<Vec3d>& up) {
+SkyHorizon recorded_sky_horizon(const RecordedConfig& config, const std::optional<Vec3d>& up) {
     SkyHorizon horizon;
-    const auto number = [&](const char* key) {
-        return config.is_object() && config.contains(key) && config[key].is_number()
-                   ? config[key].get<double>()
-                   : 0.0;
-    };
-    const double start = number("sky_horizon_start"), fade = number("sky_horizon_fade");
+    const double start = config.number("sky_horizon_start").value_or(0.0);
+    const double fade = config.number("sky_horizon_fade").value_or(0.0);
     if (!(fade > 0) || !up) return horizon;
     horizon.up = up->cast<float>();
     horizon.start_degrees = float(start);
@@ -66,13 +106,10 @@ SkyHorizon recorded_sky_horizon(const nlohmann::json& config, const std::optiona
 
 // The side rule the run was trained with (Trainer::side_rule): config grazing_side_degrees about the up of
 // the training photos. The official rule when either is missing.
-SurfelSideRule recorded_side_rule(const nlohmann::json& config, const std::optional<Vec3d>& up) {
+SurfelSideRule recorded_side_rule(const RecordedConfig& config, const std::optional<Vec3d>& up) {
     SurfelSideRule rule;
-    if (!up || !config.is_object() || !config.contains("grazing_side_degrees") ||
-        !config["grazing_side_degrees"].is_number())
-        return rule;
-    const double degrees = config["grazing_side_degrees"].get<double>();
-    if (!(degrees > 0 && degrees <= 45)) return rule;
+    const double degrees = config.number("grazing_side_degrees").value_or(0.0);
+    if (!up || !(degrees > 0 && degrees <= 45)) return rule;
     rule.up = up->cast<float>();
     rule.grazing_degrees = float(degrees);
     return rule;
@@ -134,22 +171,15 @@ TrainedRun load_trained_run(const std::string& dir) {
     run.photo_rotations = cameras.rotations;
     run.photo_centres = cameras.centres;
     if (fs::exists(run.paths.config)) {
-        const nlohmann::json c = nlohmann::json::parse(read_text_file(run.paths.config), nullptr, false);
-        if (c.is_discarded()) fail_in_file(run.paths.config, "not valid JSON");
-        if (c.is_object() && c.contains("downscale") && c["downscale"].is_number_integer())
-            run.downscale = c["downscale"].get<int>();
-        if (c.is_object() && c.contains("sky_background") && c["sky_background"].is_boolean())
-            run.sky_background = c["sky_background"].get<bool>();
-        if (c.is_object() && c.contains("sky_pins_light") && c["sky_pins_light"].is_boolean())
-            run.sky_pins_light = c["sky_pins_light"].get<bool>();
-        if (c.is_object() && c.contains("lambda_sky_residual") && c["lambda_sky_residual"].is_number())
-            run.lambda_sky_residual = std::max(0.0, c["lambda_sky_residual"].get<double>());
+        const RecordedConfig c(run.paths.config);
+        run.downscale = c.integer("downscale").value_or(0);
+        run.sky_background = c.flag("sky_background").value_or(false);
+        run.sky_pins_light = c.flag("sky_pins_light").value_or(true);
+        run.lambda_sky_residual = std::max(0.0, c.number("lambda_sky_residual").value_or(0.0));
         run.sky_horizon = recorded_sky_horizon(c, run.photos_up);
         run.side_rule = recorded_side_rule(c, run.photos_up);
-        const bool object_masks = c.is_object() && c.contains("mask_mode") && c["mask_mode"].is_string() &&
-                                  c["mask_mode"] == "object";
-        if (c.is_object() && c.contains("ground_backdrop") && c["ground_backdrop"].is_boolean() &&
-            c["ground_backdrop"].get<bool>() && !object_masks && run.sky_horizon.fade_degrees > 0)
+        const bool object_masks = c.text("mask_mode").value_or("") == "object";
+        if (c.flag("ground_backdrop").value_or(false) && !object_masks && run.sky_horizon.fade_degrees > 0)
             run.sky_horizon.ground_albedo = ground_albedo(run.model, run.sky_horizon.up);
     }
     return run;
