@@ -1,6 +1,7 @@
 // `lumigauss fit-light RUN --camera NAME|pose.json [--image PHOTO] [--scene DIR] [-o sh.txt]`: estimates the
 // environment SH of a photo of the scene with the model frozen (relight/light_fit.h) and writes it as an SH
-// text file that `render --light`, `export --light` and the viewer read.
+// text file that `render --light`, `export --light` and the viewer read (with the photo's sky residual in
+// "#sky" rows when the run learned them, shading/sh_text.h: `render --background sky` draws it).
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -170,7 +171,7 @@ void run_fit_light(FitLightOptions o) {
                     o.fit.variable == LightVariable::Sh ? "SH coefficients" : "lighting network's embedding");
     const LightFitResult r = fit_light(run, in.camera, in.photo, in.mask, o.fit);
     const std::string out = o.out.empty() ? stem_of(in.photo_path) + "_sh.txt" : o.out;
-    write_sh_text(out, r.sh);
+    write_sh_text(out, r.sh, r.sky_residual ? &*r.sky_residual : nullptr);
     if (!o.render.empty()) {
         const RasterImages<float> img =
             render_with_environment(run.model, in.camera, r.sh.cast<float>(),
@@ -183,11 +184,12 @@ void run_fit_light(FitLightOptions o) {
                 r.final_psnr, r.env_loss, out.c_str(), o.render.empty() ? "" : " and ", o.render.c_str(), s);
     if (r.sky_residual && !o.quiet)
         std::printf(
-            "fit-light: the run draws each photo's sky with a residual of its own (%s); the photo's is "
-            "fitted but not written, so `render --light %s` shows the light's own sky%s\n",
+            "fit-light: the run draws each photo's sky with a residual of its own (%s): the photo's is "
+            "written "
+            "with the light (\"#sky\" rows), so `render --light %s --background sky` draws its sky%s\n",
             run.paths.sky.c_str(), out.c_str(),
             run.sky_pins_light ? ""
-                               : " (the light itself is fitted to the surfels alone: sky_pins_light=false)");
+                               : "; the light itself is fitted to the surfels alone (sky_pins_light=false)");
 }
 
 }  // namespace
@@ -197,7 +199,8 @@ void register_fit_light(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "fit-light",
         "Estimate the environment SH of a photo of the scene with the trained model frozen; writes an SH "
-        "text file (9 rows R G B, world frame, in the model's units) for render/export --light");
+        "text file (9 rows R G B, world frame, in the model's units; with the photo's sky residual as '#sky' "
+        "rows when the run learned one) for render/export --light");
     cmd->add_option("run", o->run, "training run folder, or a bare relightable PLY (then only --via sh)")
         ->required();
     cmd->add_option("--camera", o->camera,

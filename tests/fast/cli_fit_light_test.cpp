@@ -97,8 +97,8 @@ TEST(CliFitLight, FitsATestPhotoByCameraName) {
     EXPECT_GT(s.psnr_with(fitted), 40.0);
 }
 
-// A `fast` run's skies are residuals free of its lights: the fit says that the photo's residual is not in
-// the light file and that the light comes from the surfels alone.
+// A `fast` run's skies are residuals free of its lights: the fit says that the photo's residual is written
+// with the light and that the light comes from the surfels alone.
 TEST(CliFitLight, SaysWhenTheRunsSkyIsFreeOfItsLight) {
     const testing::SharedTinyRun& tiny = testing::shared_tiny_run();
     ASSERT_EQ(tiny.exit_code, 0) << tiny.output;
@@ -109,19 +109,71 @@ TEST(CliFitLight, SaysWhenTheRunsSkyIsFreeOfItsLight) {
                           " --camera test_0000.png --iterations 10 -o " + shell_quoted(out),
                       tmp);
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    EXPECT_THAT(r.output, HasSubstr("is fitted but not written"));
+    EXPECT_THAT(r.output, HasSubstr("is written with the light"));
     EXPECT_THAT(r.output, HasSubstr("sky_pins_light=false"));
     EXPECT_TRUE(fs::exists(out));
-    // The run the other tests train has no residual: nothing to say.
+    // The run the other tests train has no residual: nothing to say, nothing but the light in the file.
     const FitSetup& s = setup();
     ASSERT_EQ(s.train.exit_code, 0) << s.train.output;
+    const std::string pinned_out = tmp / "pinned.txt";
     const CommandResult pinned =
         run_lumigauss("fit-light " + shell_quoted(s.run) + " --scene " + shell_quoted(s.scene) +
                           " --camera " + shell_quoted(s.view.name) + " --image " + shell_quoted(s.photo) +
-                          " --iterations 10 -o " + shell_quoted(tmp / "pinned.txt"),
+                          " --iterations 10 -o " + shell_quoted(pinned_out),
                       tmp);
     ASSERT_EQ(pinned.exit_code, 0) << pinned.output;
-    EXPECT_THAT(pinned.output, ::testing::Not(HasSubstr("is fitted but not written")));
+    EXPECT_THAT(pinned.output, ::testing::Not(HasSubstr("is written with the light")));
+    EXPECT_FALSE(read_sh_text_light(pinned_out).sky_residual.has_value());
+}
+
+// The photo's residual travels in the light file ("#sky" rows): `render --light FILE --background sky`
+// draws the photo's sky as the fit drew it (`fit-light --render`); the same file without those rows shows
+// the light's own sky, which a free-light run never fitted to the photo.
+TEST(CliFitLight, TheLightFileDrawsThePhotosSky) {
+    const testing::SharedTinyRun& tiny = testing::shared_tiny_run();
+    ASSERT_EQ(tiny.exit_code, 0) << tiny.output;
+    TempDir tmp("cli_fit_light_sky_rows");
+    const std::string out = tmp / "fitted.txt", bare = tmp / "bare.txt", fit_png = tmp / "fit.png";
+    const CommandResult fit =
+        run_lumigauss("fit-light " + shell_quoted(tiny.run) + " --scene " + shell_quoted(tiny.scene) +
+                          " --camera test_0000.png --iterations 30 -q -o " + shell_quoted(out) +
+                          " --render " + shell_quoted(fit_png),
+                      tmp);
+    ASSERT_EQ(fit.exit_code, 0) << fit.output;
+    ASSERT_TRUE(read_sh_text_light(out).sky_residual.has_value());
+    std::istringstream lines(synth_test::read_bytes(out));
+    std::ofstream bare_file(bare);
+    for (std::string line; std::getline(lines, line);)
+        if (line.rfind("#sky", 0) != 0) bare_file << line << "\n";
+    bare_file.close();
+    const auto render = [&](const std::string& light, const std::string& name) {
+        const CommandResult r =
+            run_lumigauss("render " + shell_quoted(tiny.run) + " --scene " + shell_quoted(tiny.scene) +
+                              " --view test_0000.png --outputs shadowed,alpha --background sky -q --light " +
+                              shell_quoted(light) + " -o " + shell_quoted(tmp / name),
+                          tmp);
+        EXPECT_EQ(r.exit_code, 0) << r.output;
+        return std::pair{read_image(tmp / name + "/test_0000_shadowed.png"),
+                         read_image(tmp / name + "/test_0000_alpha.png")};
+    };
+    const auto [with_sky, alpha] = render(out, "with");
+    const Image without_sky = render(bare, "bare").first, fitted = read_image(fit_png);
+    ASSERT_EQ(fitted.width, with_sky.width);
+    int empty = 0;
+    double with_err = 0, without_err = 0;
+    for (int y = 0; y < alpha.height; ++y)
+        for (int x = 0; x < alpha.width; ++x) {
+            if (alpha.at(x, y, 0) != 0.0f) continue;
+            ++empty;
+            for (int c = 0; c < 3; ++c) {
+                with_err = std::max(with_err, double(std::abs(with_sky.at(x, y, c) - fitted.at(x, y, c))));
+                without_err =
+                    std::max(without_err, double(std::abs(without_sky.at(x, y, c) - fitted.at(x, y, c))));
+            }
+        }
+    ASSERT_GT(empty, 20) << "no empty pixel to see the sky in";
+    EXPECT_LE(with_err, 1.5 / 255);
+    EXPECT_GT(without_err, 5.0 / 255);
 }
 
 TEST(CliFitLight, FitsThroughTheEmbeddingWithACameraJson) {

@@ -1,6 +1,7 @@
 // SH text files (shading/sh_text.h): round trip, tolerated syntax, errors naming file and line.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -128,6 +129,59 @@ TEST_F(ShText, WrongCountsAreErrors) {
     expect_error("1 2 3\n4 5 6\n# only two\n", "expected 9 coefficient lines 'R G B', found 2");
     expect_error("", "found 0");
     expect_error(kNineLines + "\n# fine\n1 2 3\n", "line 12: more than 9 coefficient lines");
+}
+
+// 25 "#sky" rows, numbered so that a shifted or reversed row shows.
+std::string sky_rows(int count) {
+    std::string rows;
+    for (int k = 0; k < count; ++k) rows += "#sky " + std::to_string(k) + " " + std::to_string(-k) + " 0.5\n";
+    return rows;
+}
+
+// A fitted light's file carries the photo's sky residual in "#sky" rows (fit-light): they round-trip, a
+// reader of the 9 rows still reads the light alone, and a file without them has no residual.
+TEST_F(ShText, SkyResidualRowsRoundTripAndStayComments) {
+    std::mt19937_64 rng(41);
+    const ShCoeffs<double> sh = sh_test::random_sh(rng);
+    Sh4Coeffs<float> sky{};
+    std::uniform_real_distribution<float> value(-2.0f, 2.0f);
+    for (Vec3f& c : sky.c) c = {value(rng), value(rng), value(rng)};
+    sky.c[24].z = 3.0e-9f;
+    const std::string path = (dir_ / "fitted_sh.txt").string();
+    write_sh_text(path, sh, &sky);
+    const ShTextLight back = read_sh_text_light(path);
+    ASSERT_TRUE(back.sky_residual.has_value());
+    for (int k = 0; k < kSh4Count; ++k)
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(back.sky_residual->c[k][c], sky.c[k][c]) << k;
+    for (int k = 0; k < kShCount; ++k)
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(back.sh.c[k][c], sh.c[k][c], 1e-8 * std::fabs(sh.c[k][c]));
+    EXPECT_EQ(read_sh_text(path).c[4].y, back.sh.c[4].y);
+    write_sh_text(path, sh);
+    EXPECT_FALSE(read_sh_text_light(path).sky_residual.has_value());
+    // Rows between the light's rows, indented, and a comment that only starts with the word.
+    const ShTextLight mixed = read_sh_text_light(
+        write("mixed.txt", "1 2 3\n" + sky_rows(25) + "  #sky01 is a comment\n" + kNineLines.substr(6)));
+    ASSERT_TRUE(mixed.sky_residual.has_value());
+    EXPECT_EQ(mixed.sky_residual->c[24].y, -24.0f);
+    EXPECT_EQ(mixed.sh.c[8].z, 9.0);
+}
+
+// A cut or damaged block would draw a wrong sky without a word: an error naming the file and the line.
+TEST_F(ShText, IncompleteSkyRowsAreErrors) {
+    const auto expect_sky_error = [&](const std::string& content, const std::string& what) {
+        const std::string path = write("bad_sky.txt", content);
+        try {
+            read_sh_text_light(path);
+            FAIL() << "expected an Error for:\n" << content;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+        }
+    };
+    expect_sky_error(kNineLines + sky_rows(24), "expected 25 '#sky' lines of the sky residual, found 24");
+    expect_sky_error(kNineLines + sky_rows(26), "line 35: more than 25 '#sky' lines");
+    expect_sky_error(kNineLines + "#sky 1 2\n", "line 10: expected '#sky R G B', found 2");
+    expect_sky_error(kNineLines + "#sky 1 nan 2\n", "line 10: 'nan' is not a finite number");
 }
 
 }  // namespace

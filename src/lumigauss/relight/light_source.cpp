@@ -63,8 +63,13 @@ ResolvedLight file_light(const std::string& path, LightKind kind, const Panorama
     light.kind = kind;
     light.source = path;
     if (!fs::exists(path)) fail_in_file(path, "missing (the --light file)");
-    light.sh = kind == LightKind::ShFile ? read_sh_text(path)
-                                         : panorama_light(path, options, &light.boosted, &light.panorama);
+    if (kind == LightKind::ShFile) {
+        ShTextLight file = read_sh_text_light(path);
+        light.sh = file.sh;
+        light.sky_residual = file.sky_residual;
+    } else {
+        light.sh = panorama_light(path, options, &light.boosted, &light.panorama);
+    }
     return light;
 }
 

@@ -2,7 +2,8 @@
 // What `--light` names, turned into a world-frame environment radiance SH (degree 2, sh.h):
 //   * a training photo of the run (its name as in appearance.json, or that name without its extension when
 //     that is unique): the learned lighting of that photo, lighting.env_sh(index);
-//   * a .txt file: 9 rows "R G B" of radiance SH in the world frame (shading/sh_text.h);
+//   * a .txt file: 9 rows "R G B" of radiance SH in the world frame (shading/sh_text.h), with the sky
+//     residual of the photo it was fitted to when `fit-light` wrote one ("#sky" rows);
 //   * a panorama (.hdr, .exr, .png, .jpg/.jpeg): equirectangular, row 0 looking along the world up axis
 //     (shading/envmap.h, frame from up_axis.h), projected onto the SH with exact pixel solid angles.
 //     LDR panoramas (PNG/JPEG) are used as stored, value/255 with no sRGB linearisation, as the official
@@ -10,6 +11,7 @@
 //     boost: every channel value above `hdr_threshold` is multiplied by `hdr_scale`.
 // An explicit prefix forces the kind: "photo:NAME", "sh:FILE", "pano:FILE". Without one, a training photo
 // name wins over a file of the same name.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +19,7 @@
 #include "lumigauss/math/vec.h"
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/shading/sh.h"
+#include "lumigauss/shading/sh_degree4.h"
 
 namespace lumigauss {
 
@@ -37,6 +40,7 @@ struct ResolvedLight {
     bool boosted = false;  // the fake HDR boost changed some pixel
     ShCoeffs<double> sh;
     Image panorama;  // a panorama light's pixels as used (boosted), for drawing its sky; else empty
+    std::optional<Sh4Coeffs<float>> sky_residual;  // an SH file's "#sky" rows, for drawing its sky
 };
 
 // True for the extensions read as LDR panoramas (.png, .jpg, .jpeg; case-insensitive).

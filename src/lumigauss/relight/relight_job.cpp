@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 #include "lumigauss/cameras/orbit.h"
 #include "lumigauss/cameras/up_axis.h"
@@ -129,22 +130,29 @@ RelightCameras relight_cameras(const RelightJob& job, const TrainedRun& run) {
 
 namespace {
 
-// The sky of one frame: the panorama itself for a panorama light, else the SH (with the photo's residual
-// when the light is a training photo of a run that learned one, not turned).
+// The sky residual a light brings: a training photo's (when the run learned them) or the one a fitted SH
+// file carries; none when the light is turned, since a residual belongs to its photo's sky as seen.
+std::optional<Sh4Coeffs<float>> light_sky_residual(const ResolvedLight& light, const TrainedRun& run,
+                                                   double degrees) {
+    if (degrees != 0) return std::nullopt;
+    if (light.kind == LightKind::Photo && light.photo_index >= 0 &&
+        light.photo_index < run.sky_residuals.num_images())
+        return run.sky_residuals.get(light.photo_index);
+    return light.sky_residual;
+}
+
+// The sky of one frame: the panorama itself for a panorama light, else the SH plus its residual, if any.
 Image frame_sky(const Camera& camera, const RelightSummary& summary, const TrainedRun& run,
                 const ShCoeffs<float>& env, const Mat3d& frame, double degrees) {
     const ResolvedLight& light = summary.light;
     if (light.kind == LightKind::Panorama && !light.panorama.pixels.empty())
         return panorama_sky_image(
             camera, {&light.panorama, frame, Vec3d{1, 1, 1} * summary.light_factor, summary.up, degrees, {}});
-    if (light.kind == LightKind::Photo && degrees == 0 && !run.sky_residuals.empty() &&
-        light.photo_index >= 0 && light.photo_index < run.sky_residuals.num_images()) {
-        Sh4Coeffs<float> residual = run.sky_residuals.get(light.photo_index);
-        for (Vec3f& c : residual.c) c = float(summary.light_factor) * c;
-        return sky_image(camera, env, &residual, run.sky_horizon);
-    }
     // The horizon is about the frame the model was trained in, so a turned light keeps it.
-    return sky_image(camera, env, nullptr, run.sky_horizon);
+    std::optional<Sh4Coeffs<float>> residual = light_sky_residual(light, run, degrees);
+    if (!residual) return sky_image(camera, env, nullptr, run.sky_horizon);
+    for (Vec3f& c : residual->c) c = float(summary.light_factor) * c;
+    return sky_image(camera, env, &*residual, run.sky_horizon);
 }
 
 }  // namespace
@@ -180,8 +188,10 @@ RelightSummary run_relight_job(const RelightJob& job, const std::function<void(c
 
     say("render: " + std::to_string(run.model.size()) + " surfels from " + job.run +
         "; light: " + light_kind_name(summary.light.kind) + " " + summary.light.source +
-        (summary.light.boosted ? " (fake HDR boost)" : "") + ", scale " + fmt("%.6g", summary.light_factor) +
-        ", up " + up_axis_name(cams.up) + "; " + std::to_string(cams.cameras.size()) + " camera(s)");
+        (summary.light.boosted ? " (fake HDR boost)" : "") +
+        (summary.light.sky_residual ? " (with its photo's sky residual)" : "") + ", scale " +
+        fmt("%.6g", summary.light_factor) + ", up " + up_axis_name(cams.up) + "; " +
+        std::to_string(cams.cameras.size()) + " camera(s)");
     if (summary.light.kind == LightKind::Panorama && job.hdr_scale != 1.0 &&
         !is_ldr_panorama(summary.light.source))
         say("  note: --hdr-scale applies to LDR panoramas (PNG/JPEG) only; " + summary.light.source +
