@@ -185,8 +185,8 @@ void run_fit_light(FitLightOptions o) {
     if (r.sky_residual && !o.quiet)
         std::printf(
             "fit-light: the run draws each photo's sky with a residual of its own (%s): the photo's is "
-            "written "
-            "with the light (\"#sky\" rows), so `render --light %s --background sky` draws its sky%s\n",
+            "written with the light (\"#sky\" rows), so `render --light %s --background sky` draws its "
+            "sky%s\n",
             run.paths.sky.c_str(), out.c_str(),
             run.sky_pins_light ? ""
                                : "; the light itself is fitted to the surfels alone (sky_pins_light=false)");

@@ -189,8 +189,9 @@ RelightSummary run_relight_job(const RelightJob& job, const std::function<void(c
     say("render: " + std::to_string(run.model.size()) + " surfels from " + job.run +
         "; light: " + light_kind_name(summary.light.kind) + " " + summary.light.source +
         (summary.light.boosted ? " (fake HDR boost)" : "") +
-        (summary.light.sky_residual ? " (with its photo's sky residual)" : "") + ", scale " +
-        fmt("%.6g", summary.light_factor) + ", up " + up_axis_name(cams.up) + "; " +
+        (summary.light.sky_residual && job.outputs.sky_background ? " (its sky with the photo's residual)"
+                                                                  : "") +
+        ", scale " + fmt("%.6g", summary.light_factor) + ", up " + up_axis_name(cams.up) + "; " +
         std::to_string(cams.cameras.size()) + " camera(s)");
     if (summary.light.kind == LightKind::Panorama && job.hdr_scale != 1.0 &&
         !is_ldr_panorama(summary.light.source))
