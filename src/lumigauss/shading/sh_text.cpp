@@ -105,9 +105,7 @@ void write_sh_text(const std::string& path, const ShCoeffs<double>& sh,
         text += buf;
     }
     if (sky_residual != nullptr) {
-        text +=
-            "# the photo's sky beyond the light's own (degree-4 SH, 25 rows R G B; lumigauss render draws "
-            "it)\n";
+        text += "# the photo's sky residual: degree-4 SH, 25 rows R G B (drawn by lumigauss render)\n";
         for (const Vec3f& v : sky_residual->c) {
             std::snprintf(buf, sizeof buf, "%s %.9g %.9g %.9g\n", kSkyPrefix, double(v.x), double(v.y),
                           double(v.z));
