@@ -26,9 +26,10 @@
 #   fast-no-grazing-side    level surfels seen at grazing angles show the camera-facing side, as officially
 #                           (grazing_side_degrees=0)
 #   fast-sky-pins-light     the sky's pixels shape the light again, no sky residual, no ground-light prior
-#                           (sky_pins_light=true, sky_residual=false, lambda_ground_light=0: the fast preset
-#                           before session 37)
+#                           (sky_pins_light=true, sky_residual=false, lambda_ground_light=0,
+#                           lambda_sky_hemisphere=0: the fast preset before session 37)
 #   fast-no-ground-light    the free light without the ground-light prior (lambda_ground_light=0)
+#   fast-no-sky-hemisphere  each photo's unseen sky left to the fit (lambda_sky_hemisphere=0)
 #   fast-no-horizon         the sky drawn in every direction, below the horizon too (sky_horizon_fade=0;
 #                           its gt-env then also fills holes with the true sky's lower half, as trained)
 #   fast-no-sky-masks       the scene's sky masks ignored (use_sky_masks=false): the background-explained
@@ -90,8 +91,9 @@ if [[ $ablations == 1 ]]; then
     add_row fast-no-ground "--preset fast --set ground_backdrop=false"
     add_row fast-no-grazing-side "--preset fast --set grazing_side_degrees=0"
     add_row fast-sky-pins-light \
-        "--preset fast --set sky_pins_light=true --set sky_residual=false --set lambda_ground_light=0"
+        "--preset fast --set sky_pins_light=true --set sky_residual=false --set lambda_ground_light=0 --set lambda_sky_hemisphere=0"
     add_row fast-no-ground-light "--preset fast --set lambda_ground_light=0"
+    add_row fast-no-sky-hemisphere "--preset fast --set lambda_sky_hemisphere=0"
     add_row fast-no-horizon "--preset fast --set sky_horizon_fade=0"
     add_row fast-no-sky-masks "--preset fast --set use_sky_masks=false"
     add_row fast-no-sky-masks-no-bg-alpha "--preset fast --set use_sky_masks=false --set lambda_background_alpha=0"

@@ -180,12 +180,15 @@ TEST(RelightTrainedRun, NamesTheMissingOrInconsistentFile) {
         EXPECT_THAT(msg, ::testing::AnyOf(HasSubstr("must be"), HasSubstr("not a JSON object"))) << bad;
     }
     // Whether the sky shaped the lights, and the residuals' weight: recorded, else the older runs' behaviour.
-    std::ofstream(run_paths(dir).config) << "{\"sky_pins_light\": false, \"lambda_sky_residual\": 0.25}";
+    std::ofstream(run_paths(dir).config)
+        << "{\"sky_pins_light\": false, \"lambda_sky_residual\": 0.25, \"lambda_sky_hemisphere\": 0.5}";
     EXPECT_FALSE(load_trained_run(dir).sky_pins_light);
     EXPECT_EQ(load_trained_run(dir).lambda_sky_residual, 0.25);
+    EXPECT_EQ(load_trained_run(dir).lambda_sky_hemisphere, 0.5);
     std::ofstream(run_paths(dir).config) << "{}";
     EXPECT_TRUE(load_trained_run(dir).sky_pins_light);
     EXPECT_EQ(load_trained_run(dir).lambda_sky_residual, 0.0);
+    EXPECT_EQ(load_trained_run(dir).lambda_sky_hemisphere, 0.0);
     fs::remove(run_paths(dir).config);
     EXPECT_NO_THROW(load_trained_run(dir));
     for (const char* f : {"model.ply", "lighting.lgmlp", "appearance.json"}) {

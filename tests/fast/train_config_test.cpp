@@ -125,6 +125,7 @@ std::vector<MemberChange> every_member() {
         {"sky_residual", [](TrainConfig& c) { c.sky_residual = true; }},
         {"lambda_sky_residual", [](TrainConfig& c) { c.lambda_sky_residual = 0.125; }},
         {"lr_sky_residual", [](TrainConfig& c) { c.lr_sky_residual = 0.03; }},
+        {"lambda_sky_hemisphere", [](TrainConfig& c) { c.lambda_sky_hemisphere = 0.5; }},
         {"sky_pins_light", [](TrainConfig& c) { c.sky_pins_light = false; }},
         {"held_out_interval", [](TrainConfig& c) { c.held_out_interval = 250; }},
         {"lighting_init_radiance", [](TrainConfig& c) { c.lighting_init_radiance = 0.7; }},
@@ -278,6 +279,8 @@ TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
         expected.insert("preset");
         // Traced shadows: measured on the fast schedule only (train_preset).
         if (std::string(improved) == "fast") expected.insert("geometric_transfer_every");
+        // The sky hemisphere prior: measured on the fast schedule only so far (train_preset).
+        if (std::string(improved) == "fast") expected.insert("lambda_sky_hemisphere");
         EXPECT_EQ(differing, expected);
         EXPECT_EQ(a.at("preset"), improved);
     }
@@ -293,6 +296,9 @@ TEST(TrainConfigPreset, DefaultAndFastAddTheImprovementsToThePaper) {
     EXPECT_EQ(paper.geometric_transfer_every, 0);
     EXPECT_EQ(train_preset("default").geometric_transfer_every, 0);
     EXPECT_EQ(train_preset("fast").geometric_transfer_every, 500);
+    EXPECT_EQ(paper.lambda_sky_hemisphere, 0.0);
+    EXPECT_EQ(train_preset("default").lambda_sky_hemisphere, 0.0);
+    EXPECT_EQ(train_preset("fast").lambda_sky_hemisphere, 1.0);
     EXPECT_FALSE(paper.ground_backdrop);
     EXPECT_FALSE(paper.ground_seeds);
     EXPECT_EQ(paper.grazing_side_degrees, 0.0);
@@ -323,7 +329,7 @@ TEST(TrainConfigFields, JsonHasOneKeyPerMember) {
     ASSERT_TRUE(j.is_object());
     const std::vector<MemberChange> members = every_member();
     // The list above covers every member of the struct (update it when a field is added) ...
-    static_assert(member_count<TrainConfig>() == 77, "a TrainConfig member was added or removed");
+    static_assert(member_count<TrainConfig>() == 78, "a TrainConfig member was added or removed");
     ASSERT_EQ(members.size(), member_count<TrainConfig>());
     // ... and the JSON has exactly those keys.
     std::set<std::string> names;
@@ -701,6 +707,7 @@ TEST(TrainConfigValidate, RejectsEachBadValueNamingTheKey) {
         {"min_ground_views", [](TrainConfig& c) { c.min_ground_views = -1; }},
         {"min_ground_views", [](TrainConfig& c) { c.min_ground_views = 1001; }},
         {"geometric_transfer_every", [](TrainConfig& c) { c.geometric_transfer_every = -1; }},
+        {"lambda_sky_hemisphere", [](TrainConfig& c) { c.lambda_sky_hemisphere = -0.5; }},
         {"shadow_bounce", [](TrainConfig& c) { c.shadow_bounce = -0.1; }},
         {"shadow_bounce", [](TrainConfig& c) { c.shadow_bounce = 1.5; }},
         {"lambda_scale_ratio", [](TrainConfig& c) { c.lambda_scale_ratio = -0.1; }},

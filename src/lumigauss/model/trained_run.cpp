@@ -176,6 +176,7 @@ TrainedRun load_trained_run(const std::string& dir) {
         run.sky_background = c.flag("sky_background").value_or(false);
         run.sky_pins_light = c.flag("sky_pins_light").value_or(true);
         run.lambda_sky_residual = std::max(0.0, c.number("lambda_sky_residual").value_or(0.0));
+        run.lambda_sky_hemisphere = std::max(0.0, c.number("lambda_sky_hemisphere").value_or(0.0));
         run.sky_horizon = recorded_sky_horizon(c, run.photos_up);
         run.side_rule = recorded_side_rule(c, run.photos_up);
         const bool object_masks = c.text("mask_mode").value_or("") == "object";

@@ -29,7 +29,8 @@ struct TrainedRun {
     // config.json "sky_pins_light": whether the sky's pixels shaped the photos' lights in training (true
     // without the record, as every run before the key). False: the sky was the residual's alone.
     bool sky_pins_light = true;
-    double lambda_sky_residual = 0;  // config.json's L2 weight on those residuals (0 without the record)
+    double lambda_sky_residual = 0;    // config.json's L2 weight on those residuals (0 without the record)
+    double lambda_sky_hemisphere = 0;  // config.json's hemisphere prior on them (0 without the record)
     // The world's up as the training photos that scene.json records give it (camera_up_direction); none
     // without the record (a bare PLY, a run of an older version).
     std::optional<Vec3d> photos_up;

@@ -16,6 +16,7 @@
 #include "lumigauss/train/image_losses.h"
 #include "lumigauss/train/lighting_mlp_gradients.h"
 #include "lumigauss/train/physical_losses.h"
+#include "lumigauss/train/sky_hemisphere_prior.h"
 #include "lumigauss/train/view_shading_backward.h"
 #include "lumigauss/util/error.h"
 
@@ -192,6 +193,7 @@ class FrozenViewObjective {
             sky_pins_light_ = run.sky_pins_light;
             with_residual_ = !run.sky_residuals.empty();
             lambda_residual_ = run.lambda_sky_residual;
+            if (with_residual_ && run.lambda_sky_hemisphere > 0) init_hemisphere_prior(run);
         }
     }
 
@@ -231,6 +233,10 @@ class FrozenViewObjective {
                 v.g_residual.c[k] = float(2 * lambda_residual_) * residual.c[k];
             }
             v.loss += lambda_residual_ * penalty;
+            if (sky_target_) {
+                v.loss += lambda_hemisphere_ * sky_hemisphere_prior(unseen_sky_, env, residual, *sky_target_,
+                                                                    lambda_hemisphere_, v.g_residual);
+            }
         }
         v.psnr = fitted_psnr();
         if (with_gradient) add_render_gradient(env, v);
@@ -250,6 +256,20 @@ class FrozenViewObjective {
     }
 
   private:
+    // As training's prior on the photo's sky (train/sky_hemisphere_prior.h). The fit has no sky mask: the
+    // photo's sky is taken where the frozen surfels leave the photo uncovered above the horizon.
+    void init_hemisphere_prior(const TrainedRun& run) {
+        const std::size_t pixels = rays_.size();
+        std::vector<float> seen(pixels, 0.0f);
+        for (std::size_t p = 0; p < pixels; ++p)
+            if (images_.alpha[p] < 0.5f && mask_.pixels[p] > 0 && dot(rays_[p], run.sky_horizon.up) > 0)
+                seen[p] = 1.0f;
+        sky_target_ = mean_sky_radiance(photo_.pixels, seen, kSkyHemisphereMinPixels);
+        unseen_sky_ = directions_out_of_view(
+            upper_hemisphere_directions(run.sky_horizon.up, kSkyHemisphereDirections), camera_);
+        lambda_hemisphere_ = run.lambda_sky_hemisphere;
+    }
+
     void add_render_gradient(const ShCoeffs<float>& env, Value& v) {
         ShCoeffs<float>& g_env = v.g_env;
         if (!rays_.empty()) {
@@ -291,7 +311,9 @@ class FrozenViewObjective {
     std::vector<Vec3f> rays_;  // every pixel's world ray, when the sky is drawn behind; else empty
     SkyHorizon horizon_;
     bool sky_pins_light_ = true, with_residual_ = false;
-    double lambda_residual_ = 0;
+    double lambda_residual_ = 0, lambda_hemisphere_ = 0;
+    std::optional<Vec3f> sky_target_;  // the hemisphere prior's target radiance (none: no prior)
+    std::vector<Vec3f> unseen_sky_;
     SkyPixels sky_;
     std::vector<float> g_sky_;
 };

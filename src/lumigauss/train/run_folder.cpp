@@ -32,6 +32,7 @@ std::string step_log_line(const StepReport& r, double elapsed_seconds, const Hel
     j["background_alpha"] = r.background_alpha;
     j["opacity"] = r.opacity;
     j["sky_residual"] = r.sky_residual;
+    j["sky_hemisphere"] = r.sky_hemisphere;
     j["scale_ratio"] = r.scale_ratio;
     // The transfer-fitting stage renders no photo: null, not 0, so that plots of the log show a gap, not a
     // dip.

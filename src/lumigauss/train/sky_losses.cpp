@@ -8,7 +8,6 @@
 namespace lumigauss {
 namespace {
 
-constexpr double kSaturated = 0.98;
 constexpr double kCosineWeight = 0.1;
 constexpr double kNormEps = 1e-6;
 constexpr double kLinearWeight = 0.1;
@@ -67,7 +66,7 @@ double sky_colour_loss(std::span<const float> sky, std::span<const float> radian
     for (std::size_t p = 0; p < pixels; ++p) {
         if (!(sky_weight[p] > 0)) continue;
         const bool saturated =
-            std::max({photo[3 * p], photo[3 * p + 1], photo[3 * p + 2]}) >= float(kSaturated);
+            std::max({photo[3 * p], photo[3 * p + 1], photo[3 * p + 2]}) >= float(kSaturatedPhoto);
         if (!saturated) used.push_back(p);
     }
     if (used.empty()) return 0.0;

@@ -12,6 +12,10 @@
 
 namespace lumigauss {
 
+// A photo pixel with any channel at or above this is taken as clipped (the sun, its glare): the sky losses
+// leave it out, its true radiance is unknown.
+inline constexpr double kSaturatedPhoto = 0.98;
+
 // 1 where `mask` >= 0.5 and every pixel within `radius` (a square) does too, else 0. Pixels outside the
 // image count as inside the mask, so that a sky touching the image border is not eaten there.
 std::vector<float> eroded_mask(const Image& mask, int radius);

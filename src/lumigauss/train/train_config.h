@@ -116,6 +116,12 @@ struct TrainConfig {
     bool sky_residual = false;
     double lambda_sky_residual = 0.01;
     double lr_sky_residual = 0.02;
+    // With sky residuals: each photo's sky radiance (light + residual), at those of 64 directions spread over
+    // the upper hemisphere that its camera does not see, pulled towards the mean radiance of the photo's sky
+    // pixels (its sky mask; without masks, the pixels the sky background already explains), squared error,
+    // gradient to the residual only (train/sky_hemisphere_prior.h). Without it, a photo's light seen from a
+    // new viewpoint drew a sky that no photo constrained, often black. 0 = off.
+    double lambda_sky_hemisphere = 0.0;
     // Whether the sky pixels' gradient reaches the lighting. A degree-2 SH cannot draw a sky with a sun (it
     // saturates where the sun's lobe is, and rings below zero 90 degrees away), so a sky drawn from the light
     // alone bends each photo's light towards its sky's look. false: the sky's gradient goes to its residual

@@ -19,6 +19,7 @@
 #include "lumigauss/train/image_losses.h"
 #include "lumigauss/train/physical_losses.h"
 #include "lumigauss/train/scale_ratio_penalty.h"
+#include "lumigauss/train/sky_hemisphere_prior.h"
 #include "lumigauss/train/sky_losses.h"
 #include "lumigauss/train/view_shading_backward.h"
 #include "lumigauss/util/error.h"
@@ -210,6 +211,7 @@ struct Trainer::ViewMasks {
     std::vector<float> empty_unshrunk;
     std::vector<float> sky;          // pixels whose photo shows the sky (eroded sky mask); empty: no sky mask
     std::vector<float> regularizer;  // the normal/distortion losses' mask
+    std::vector<Vec3f> unseen_sky;   // the sky hemisphere prior's directions: those the camera does not see
 };
 
 struct Trainer::Scratch {
@@ -308,6 +310,9 @@ void Trainer::prepare_view_masks() {
         const std::size_t pixels = view.mask.pixels.size();
         m.photometric = view.mask.pixels;
         m.regularizer = view.mask.pixels;
+        if (c.lambda_sky_hemisphere > 0)
+            m.unseen_sky = directions_out_of_view(upper_hemisphere_directions(up_, kSkyHemisphereDirections),
+                                                  view.camera);
         if (!view.sky.pixels.empty() && c.use_sky_masks) {
             m.sky = eroded_mask(view.sky, c.sky_mask_erosion);
             if (c.sky_free_regularizers)
@@ -535,6 +540,20 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
             }
             report.sky_residual = penalty;
             report.total += c.lambda_sky_residual * penalty;
+            if (c.lambda_sky_hemisphere > 0) {
+                // The sky the photo shows: its sky mask, else what the sky background already explains.
+                const std::span<const float> seen =
+                    !masks.sky.empty()
+                        ? std::span<const float>(masks.sky)
+                        : (match_background ? std::span<const float>(s.matched) : std::span<const float>());
+                const std::optional<Vec3f> sky_target =
+                    seen.empty() ? std::nullopt : mean_sky_radiance(target, seen, kSkyHemisphereMinPixels);
+                if (sky_target) {
+                    report.sky_hemisphere = sky_hemisphere_prior(masks.unseen_sky, clean, sky_residual,
+                                                                 *sky_target, c.lambda_sky_hemisphere, g_res);
+                    report.total += c.lambda_sky_hemisphere * report.sky_hemisphere;
+                }
+            }
             sky_residual_grads_.add(report.view, g_res);
         }
     }
@@ -639,7 +658,8 @@ void Trainer::check_finite(std::int64_t it, const StepReport& r) const {
                                                     {"loss background alpha", r.background_alpha},
                                                     {"loss opacity", r.opacity},
                                                     {"loss scale ratio", r.scale_ratio},
-                                                    {"loss sky residual", r.sky_residual}};
+                                                    {"loss sky residual", r.sky_residual},
+                                                    {"loss sky hemisphere", r.sky_hemisphere}};
     for (const auto& [name, value] : terms)
         if (!std::isfinite(value)) throw NonFiniteError(it, name);
     for (int p = 0; p < kModelParamCount; ++p)

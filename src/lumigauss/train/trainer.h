@@ -66,7 +66,7 @@ struct StepReport {
     double range01 = 0, consistency = 0, shadow = 0;
     double env = 0, ground_light = 0, normal = 0, distortion = 0;
     double sky_alpha = 0, sky_colour = 0, background_alpha = 0, opacity = 0, sky_residual = 0,
-           scale_ratio = 0;
+           sky_hemisphere = 0, scale_ratio = 0;
     double psnr = 0;  // masked PSNR of the stage's main render (shadowed in stage 3), 0 in stage 2
     std::size_t surfels = 0;
     DensifyReport densified{};
