@@ -144,6 +144,35 @@ TEST(ViewSceneInfo, PassesTheRunsSkyHorizonToTheViewer) {
     EXPECT_EQ(j["sky_horizon"]["ground_albedo"][2].get<double>(), 0.75);  // the ground drawn below it
 }
 
+// Each training photo's light carries its sky residual when the run learned them, an SH file's light the
+// residual of its "#sky" rows; the others none (the page then draws the light's sky alone).
+TEST(ViewSceneInfo, LightsCarryTheirSkyResiduals) {
+    const Camera cam = testing::test_camera();
+    TrainedRun run =
+        relight_test::in_memory_run(relight_test::random_model(cam, 4, 30), {"p0.jpg", "p1.jpg"});
+    run.sky_residuals = SkyResiduals(2);
+    run.sky_residuals.params()[SkyResiduals::kRowWidth + 3 * 24 + 1] = -0.25f;  // p1.jpg, k = 24, green
+    ResolvedLight with_rows, without_rows;
+    with_rows.kind = without_rows.kind = LightKind::ShFile;
+    with_rows.source = "fitted.txt", without_rows.source = "plain.txt";
+    with_rows.sky_residual = Sh4Coeffs<float>{};
+    with_rows.sky_residual->c[9] = {0.75f, 0.0f, -0.5f};
+    const nlohmann::json j = nlohmann::json::parse(
+        scene_json(describe_scene(run, {with_rows, without_rows}, parse_up_axis("-y"), cam)));
+    ASSERT_EQ(j["lights"].size(), 5u);
+    ASSERT_EQ(j["lights"][0]["sky_residual"].size(), 25u);
+    EXPECT_EQ(j["lights"][0]["sky_residual"][9][2].get<double>(), -0.5);
+    EXPECT_FALSE(j["lights"][1].contains("sky_residual"));
+    ASSERT_EQ(j["lights"][3]["sky_residual"].size(), 25u);  // p1.jpg
+    EXPECT_EQ(j["lights"][3]["sky_residual"][24][1].get<double>(), -0.25);
+    EXPECT_EQ(j["lights"][2]["sky_residual"][24][1].get<double>(), 0.0);  // p0.jpg's: all zero
+    EXPECT_FALSE(j["lights"][4].contains("sky_residual"));                // uniform
+    run.sky_residuals = SkyResiduals();
+    const nlohmann::json bare =
+        nlohmann::json::parse(scene_json(describe_scene(run, {}, parse_up_axis("-y"), cam)));
+    EXPECT_FALSE(bare["lights"][0].contains("sky_residual")) << "a run without residuals";
+}
+
 // The viewer's shader picks each surfel's side as the run was trained (shading/surfel_side.h).
 TEST(ViewSceneInfo, PassesTheRunsSideRuleToTheViewer) {
     const Camera cam = testing::test_camera();

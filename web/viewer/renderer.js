@@ -138,8 +138,9 @@ export class SplatRenderer {
   // ball: null or {mode: 0|1, size (pixels)}; sky: draw the light's sky behind the colour views;
   // horizon: null or the scene's sky_horizon {up, start_degrees, fade_degrees, ground_albedo} (where that
   // sky ends, and the ground drawn below); sides: null or the scene's side_rule {up, grazing_degrees}
-  // (which side of a surfel the camera sees, shading/surfel_side.h).
-  render(view, env, mode, ball, sky = false, horizon = null, sides = null) {
+  // (which side of a surfel the camera sees, shading/surfel_side.h); residual: null or the light's sky
+  // residual {coeffs: Float32Array(75), turn: the rows of R^T for the light's turn about up (3 x 3)}.
+  render(view, env, mode, ball, sky = false, horizon = null, sides = null, residual = null) {
     const gl = this.gl;
     const { width, height } = view;
     if (this.canvas.width !== width || this.canvas.height !== height) {
@@ -202,6 +203,13 @@ export class SplatRenderer {
     gl.uniform4f(c.u.u_intr, view.fx, view.fy, view.cx, view.cy);
     gl.uniform2f(c.u.u_size, width, height);
     gl.uniform3fv(c.u.u_env, env);
+    gl.uniform1i(c.u.u_hasResidual, residual ? 1 : 0);
+    if (residual) {
+      gl.uniform3fv(c.u.u_residual, residual.coeffs);
+      gl.uniform3fv(c.u.u_turn0, residual.turn[0]);
+      gl.uniform3fv(c.u.u_turn1, residual.turn[1]);
+      gl.uniform3fv(c.u.u_turn2, residual.turn[2]);
+    }
     gl.bindVertexArray(this.emptyVao);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
     // 3. The environment ball in the top right corner.

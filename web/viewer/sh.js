@@ -89,3 +89,24 @@ export function parseShText(text) {
   if (rows.length !== 9) throw new Error(`expected 9 coefficient rows, found ${rows.length}`);
   return rows;
 }
+
+// The sky residual of an SH text file (shading/sh_text.h): 25 lines "#sky R G B" (the word "#sky" first;
+// "#sky01" is an ordinary comment), null when the file has none. Throws an Error naming the line on a
+// damaged row, and on a block that is not 25 rows.
+export function parseShSkyRows(text) {
+  const rows = [];
+  const lines = text.split(/\r?\n/);
+  for (let i = 0; i < lines.length; ++i) {
+    const m = /^[ \t]*#sky(?:[ \t]+(.*))?$/.exec(lines[i]);
+    if (!m) continue;
+    const parts = (m[1] || '').replace(/#.*/, '').split(/[\s,]+/).filter((p) => p.length);
+    const values = parts.map(Number);
+    if (values.length !== 3 || !values.every(Number.isFinite))
+      throw new Error(`line ${i + 1}: expected "#sky R G B", got "${lines[i].trim()}"`);
+    if (rows.length === 25) throw new Error(`line ${i + 1}: more than 25 "#sky" lines`);
+    rows.push(values);
+  }
+  if (rows.length !== 0 && rows.length !== 25)
+    throw new Error(`expected 25 "#sky" lines of the sky residual, found ${rows.length}`);
+  return rows.length ? rows : null;
+}

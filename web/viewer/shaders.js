@@ -191,11 +191,49 @@ void main() {
 }
 `;
 
+// The sky's per-photo residual (shading/sh_degree4.h: bands 3 and 4 in its order and constants; bands 0-2
+// are sh.h's), added to the light's radiance in the sky only. It is evaluated at u_turn * d: the light's
+// turn about the up axis (rotateAboutUp) applied to the residual as f'(w) = f(R^T w), rows of R^T.
+const SKY_RESIDUAL_GLSL = `
+uniform bool u_hasResidual;
+uniform vec3 u_residual[25];
+uniform vec3 u_turn0, u_turn1, u_turn2;
+vec3 skyResidual(vec3 w) {
+  vec3 d = vec3(dot(u_turn0, w), dot(u_turn1, w), dot(u_turn2, w));
+  float x = d.x, y = d.y, z = d.z, x2 = x * x, y2 = y * y, z2 = z * z;
+  float b[25];
+  b[0] = ${f(Y00)};
+  b[1] = ${f(Y1)} * y; b[2] = ${f(Y1)} * z; b[3] = ${f(Y1)} * x;
+  b[4] = ${f(Y2)} * x * y; b[5] = ${f(Y2)} * y * z; b[6] = ${f(Y20)} * (3.0 * z2 - 1.0);
+  b[7] = ${f(Y2)} * x * z; b[8] = ${f(Y22)} * (x2 - y2);
+  b[9] = ${f(0.5900435899266435)} * y * (3.0 * x2 - y2);
+  b[10] = ${f(2.890611442640554)} * x * y * z;
+  b[11] = ${f(0.4570457994644658)} * y * (5.0 * z2 - 1.0);
+  b[12] = ${f(0.3731763325901154)} * z * (5.0 * z2 - 3.0);
+  b[13] = ${f(0.4570457994644658)} * x * (5.0 * z2 - 1.0);
+  b[14] = ${f(1.445305721320277)} * z * (x2 - y2);
+  b[15] = ${f(0.5900435899266435)} * x * (x2 - 3.0 * y2);
+  b[16] = ${f(2.503342941796705)} * x * y * (x2 - y2);
+  b[17] = ${f(1.770130769779931)} * y * z * (3.0 * x2 - y2);
+  b[18] = ${f(0.9461746957575601)} * x * y * (7.0 * z2 - 1.0);
+  b[19] = ${f(0.6690465435572892)} * y * z * (7.0 * z2 - 3.0);
+  b[20] = ${f(0.1057855469152043)} * (35.0 * z2 * z2 - 30.0 * z2 + 3.0);
+  b[21] = ${f(0.6690465435572892)} * x * z * (7.0 * z2 - 3.0);
+  b[22] = ${f(0.4730873478787800)} * (x2 - y2) * (7.0 * z2 - 1.0);
+  b[23] = ${f(1.770130769779931)} * x * z * (x2 - 3.0 * y2);
+  b[24] = ${f(0.6258357354491761)} * (x2 * (x2 - 3.0 * y2) - y2 * (3.0 * x2 - y2));
+  vec3 r = vec3(0.0);
+  for (int k = 0; k < 25; ++k) r += b[k] * u_residual[k];
+  return r;
+}
+`;
+
 // The per-pixel step after blending: what the C++ does to the rasterised maps before writing PNGs.
 // With u_sky, the colour views are composited over the light's sky (shading/sky_colour.h: the radiance
 // along the pixel's ray, floored at 1e-4, to the power 1/2.2, clipped at 1), as `render --background sky`,
 // fading out below the horizon as the run was trained (sky_visibility in shading/sky_colour.h) into the
-// ground drawn there (ground_colour).
+// ground drawn there (ground_colour). The sky's radiance is the light's plus the light's sky residual, when
+// it has one (sky_radiance in sky_colour.h).
 export const COMPOSITE_FS = `#version 300 es
 precision highp float;
 uniform highp sampler2D u_accum;
@@ -209,6 +247,7 @@ uniform vec3 u_r0, u_r1, u_r2;  // world-to-camera rotation, rows
 uniform vec4 u_intr;            // fx, fy, cx, cy
 uniform vec2 u_size;
 ${SH_GLSL}
+${SKY_RESIDUAL_GLSL}
 out vec4 o_colour;
 vec3 sky() {
   vec2 px = vec2(gl_FragCoord.x, u_size.y - gl_FragCoord.y);  // pixel centre, image rows from the top
@@ -220,7 +259,9 @@ vec3 sky() {
     visible = clamp((u_horizonSines.y - depression) / max(u_horizonSines.y - u_horizonSines.x, 1e-6), 0.0, 1.0);
   }
   vec3 ground = u_groundAlbedo * intensity(irradiance(u_horizonUp));
-  return visible * min(pow(max(radiance(d), vec3(1e-4)), vec3(1.0 / 2.2)), vec3(1.0)) + (1.0 - visible) * ground;
+  vec3 l = radiance(d);
+  if (u_hasResidual) l += skyResidual(d);
+  return visible * min(pow(max(l, vec3(1e-4)), vec3(1.0 / 2.2)), vec3(1.0)) + (1.0 - visible) * ground;
 }
 void main() {
   vec4 c = texelFetch(u_accum, ivec2(gl_FragCoord.xy), 0);

@@ -10,7 +10,7 @@ import { OrbitCamera, parseCameraParam } from './orbit.js';
 import { SplatRenderer } from './renderer.js';
 import { MODES } from './shaders.js';
 import { decodePanoramaFile, panoramaFrameForUp, parseRadianceHdr, projectPanoramaToSh } from './panorama.js';
-import { parseShText, rotateAboutUp, scaleSh } from './sh.js';
+import { parseShSkyRows, parseShText, rotateAboutUp, rotationAboutAxis, scaleSh } from './sh.js';
 
 const NEAR = 0.2;  // render/raster_constants.h kNearPlane
 const $ = (id) => document.getElementById(id);
@@ -177,12 +177,17 @@ function base64(bytes) {
   return btoa(s);
 }
 
+// A light of scene.json as the page keeps it (sky_residual: null unless the light has one).
+function lightOfScene(l) {
+  return { name: l.name, kind: l.kind, sh: l.sh, sky_residual: l.sky_residual || null };
+}
+
 class Viewer {
   constructor(scene, model, version) {
     this.scene = scene;
     this.version = version;
     this.reloads = 0;
-    this.lights = scene.lights.map((l) => ({ name: l.name, kind: l.kind, sh: l.sh }));
+    this.lights = scene.lights.map(lightOfScene);
     this.lightIndex = scene.initial_light || 0;
     this.rotation = 0;
     this.exposure = 0;
@@ -198,11 +203,19 @@ class Viewer {
     this.updateEnvironment();
   }
 
-  // exposure * light SH, turned about the up axis, as the shader's uniform.
+  // exposure * light SH, turned about the up axis, as the shader's uniform; the same for the light's sky
+  // residual, turned in the shader (the rows of R^T), as rotateAboutUp turns the light.
   updateEnvironment() {
     const light = this.lights[this.lightIndex];
-    const sh = rotateAboutUp(scaleSh(light.sh, 2 ** this.exposure), this.scene.up, this.rotation);
+    const scale = 2 ** this.exposure;
+    const sh = rotateAboutUp(scaleSh(light.sh, scale), this.scene.up, this.rotation);
     this.env = new Float32Array(sh.flat());
+    this.skyResidual = null;
+    if (light.sky_residual) {
+      const R = rotationAboutAxis(this.scene.up, (this.rotation * Math.PI) / 180);
+      this.skyResidual = { coeffs: new Float32Array(scaleSh(light.sky_residual, scale).flat()),
+                           turn: [0, 1, 2].map((i) => [R[0][i], R[1][i], R[2][i]]) };
+    }
     this.dirty = true;
   }
 
@@ -222,7 +235,7 @@ class Viewer {
     const lightName = this.lights[this.lightIndex].name;
     const added = this.lights.filter((l) => l.local);  // SH files loaded in this page: keep them
     this.scene = Object.assign(scene, { up: this.scene.up, e1: this.scene.e1, e2: this.scene.e2 });
-    this.lights = scene.lights.map((l) => ({ name: l.name, kind: l.kind, sh: l.sh })).concat(added);
+    this.lights = scene.lights.map(lightOfScene).concat(added);
     const same = this.lights.findIndex((l) => l.name === lightName);
     this.lightIndex = same >= 0 ? same : scene.initial_light || 0;
     // The old worker first: no order for the old model may reach the new one's buffers.
@@ -267,7 +280,8 @@ class Viewer {
 
   draw(view, withBall = true) {
     this.renderer.render(view, this.env, this.mode, withBall && this.ball.mode !== 'off' ? this.ball : null,
-                         this.sky, this.scene.sky_horizon || null, this.scene.side_rule || null);
+                         this.sky, this.scene.sky_horizon || null, this.scene.side_rule || null,
+                         this.skyResidual);
   }
 
   // --- interactive use ---
@@ -358,9 +372,12 @@ class Viewer {
     if (!file) return;
     try {
       const panorama = /\.(hdr|exr|png|jpe?g)$/i.test(file.name);
+      const text = panorama ? null : await file.text();
       const sh = panorama ? projectPanoramaToSh(await decodePanoramaFile(file), panoramaFrameForUp(this.scene.up))
-                          : parseShText(await file.text());
-      this.lights.push({ name: file.name, kind: panorama ? 'panorama' : 'SH file', sh, local: true });
+                          : parseShText(text);
+      const skyResidual = panorama ? null : parseShSkyRows(text);
+      this.lights.push({ name: file.name, kind: panorama ? 'panorama' : 'SH file', sh, sky_residual: skyResidual,
+                         local: true });
       this.lightIndex = this.lights.length - 1;
       this.fillLightMenu();
       this.updateEnvironment();
@@ -476,6 +493,18 @@ class Viewer {
     $('shfile').files = file.files;
     await this.loadLightFile($('shfile').files[0]);
     checks.sh_file = this.lights[this.lightIndex].name === 'test_sh.txt' && this.env[6] === 0.5 * 2;
+    // A fitted light's file: its 25 "#sky" rows are the light's sky residual; a damaged row is refused.
+    const nine = '1 1 1\n' + '0 0 0\n'.repeat(8);
+    const skyRows = Array.from({ length: 25 }, (_, k) => (k === 1 ? '#sky 0.5 0.25 0.125\n' : '#sky 0 0 0\n')).join('');
+    await this.loadLightFile(new File([nine + skyRows], 'fitted_sh.txt'));
+    checks.sh_file_sky_rows = this.lights[this.lightIndex].name === 'fitted_sh.txt' &&
+      this.skyResidual !== null && this.skyResidual.coeffs[4] === 0.25 * 2;
+    this.lights.pop();
+    await this.loadLightFile(new File([nine + '#sky 1 2\n'], 'damaged_sh.txt'));
+    checks.sh_file_bad_sky_row = this.lights[this.lights.length - 1].name !== 'damaged_sh.txt' &&
+      $('message').textContent.includes('line 10');
+    this.lightIndex = this.lights.length - 1;
+    this.updateEnvironment();
     const canvas = $('canvas'), az = this.camera.azimuth, dist = this.camera.distance;
     const pointer = (type, x, extra = {}) =>
       canvas.dispatchEvent(new PointerEvent(type, { pointerId: 1, clientX: x, clientY: 10, button: 0, buttons: 1, ...extra }));
@@ -549,6 +578,7 @@ class Viewer {
       report.controls = await this.checkControls();
       report.panorama_check = this.panoramaCheck;
     }
+    if (params.has('sky')) this.sky = true;  // the light's sky behind the surfels, whatever the run
     const degrees = Number(params.get('rot') || 0);
     this.rotation = degrees;
     this.updateEnvironment();

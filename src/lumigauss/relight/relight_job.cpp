@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <numbers>
 #include <optional>
 
 #include "lumigauss/cameras/orbit.h"
@@ -13,6 +14,8 @@
 #include "lumigauss/relight/relit_render.h"
 #include "lumigauss/relight/relit_sky.h"
 #include "lumigauss/relight/video.h"
+#include "lumigauss/shading/sh4_rotation.h"
+#include "lumigauss/shading/sh_rotation.h"
 #include "lumigauss/shading/sky_image.h"
 #include "lumigauss/util/error.h"
 #include "lumigauss/util/text.h"
@@ -131,14 +134,16 @@ RelightCameras relight_cameras(const RelightJob& job, const TrainedRun& run) {
 namespace {
 
 // The sky residual a light brings: a training photo's (when the run learned them) or the one a fitted SH
-// file carries; none when the light is turned, since a residual belongs to its photo's sky as seen.
+// file carries, turned about `up` with the light (the whole sky turns, as rotate_about_up turns the light).
 std::optional<Sh4Coeffs<float>> light_sky_residual(const ResolvedLight& light, const TrainedRun& run,
-                                                   double degrees) {
-    if (degrees != 0) return std::nullopt;
+                                                   Vec3d up, double degrees) {
+    std::optional<Sh4Coeffs<float>> residual = light.sky_residual;
     if (light.kind == LightKind::Photo && light.photo_index >= 0 &&
         light.photo_index < run.sky_residuals.num_images())
-        return run.sky_residuals.get(light.photo_index);
-    return light.sky_residual;
+        residual = run.sky_residuals.get(light.photo_index);
+    if (residual && degrees != 0)
+        residual = rotate_sh4(*residual, rotation_about_axis(up, degrees * std::numbers::pi / 180.0));
+    return residual;
 }
 
 // The sky of one frame: the panorama itself for a panorama light, else the SH plus its residual, if any.
@@ -149,7 +154,7 @@ Image frame_sky(const Camera& camera, const RelightSummary& summary, const Train
         return panorama_sky_image(
             camera, {&light.panorama, frame, Vec3d{1, 1, 1} * summary.light_factor, summary.up, degrees, {}});
     // The horizon is about the frame the model was trained in, so a turned light keeps it.
-    std::optional<Sh4Coeffs<float>> residual = light_sky_residual(light, run, degrees);
+    std::optional<Sh4Coeffs<float>> residual = light_sky_residual(light, run, summary.up, degrees);
     if (!residual) return sky_image(camera, env, nullptr, run.sky_horizon);
     for (Vec3f& c : residual->c) c = float(summary.light_factor) * c;
     return sky_image(camera, env, &*residual, run.sky_horizon);

@@ -68,11 +68,14 @@ ViewerScene describe_scene(const TrainedRun& run, const std::vector<ResolvedLigh
     scene.side_rule = run.side_rule;
     model_extent(run.model, scene);
     for (const ResolvedLight& l : extra_lights)
-        scene.lights.push_back({light_name(l), light_kind_name(l.kind), l.sh});
-    for (std::size_t i = 0; i < run.image_names.size(); ++i)
+        scene.lights.push_back({light_name(l), light_kind_name(l.kind), l.sh, l.sky_residual});
+    for (std::size_t i = 0; i < run.image_names.size(); ++i) {
+        std::optional<Sh4Coeffs<float>> residual;
+        if (!run.sky_residuals.empty()) residual = run.sky_residuals.get(int(i));
         scene.lights.push_back(
-            {run.image_names[i], light_kind_name(LightKind::Photo), run.learned_sh(int(i))});
-    scene.lights.push_back({"uniform", "uniform", uniform_environment()});
+            {run.image_names[i], light_kind_name(LightKind::Photo), run.learned_sh(int(i)), residual});
+    }
+    scene.lights.push_back({"uniform", "uniform", uniform_environment(), std::nullopt});
     return scene;
 }
 
@@ -80,8 +83,15 @@ std::string scene_json(const ViewerScene& scene) {
     Vec3d e1, e2;
     orbit_basis(scene.up, e1, e2);
     json lights = json::array();
-    for (const ViewerLight& l : scene.lights)
-        lights.push_back({{"name", l.name}, {"kind", l.kind}, {"sh", sh_json(l.sh)}});
+    for (const ViewerLight& l : scene.lights) {
+        json light = {{"name", l.name}, {"kind", l.kind}, {"sh", sh_json(l.sh)}};
+        if (l.sky_residual) {
+            json rows = json::array();
+            for (const Vec3f& row : l.sky_residual->c) rows.push_back(vec_json(row.cast<double>()));
+            light["sky_residual"] = rows;
+        }
+        lights.push_back(light);
+    }
     json j = {{"format", "lumigauss-viewer-scene"},
               {"version", 1},
               {"surfels", scene.surfels},

@@ -6,14 +6,18 @@
 //    "centre": [x, y, z], "radius": r,
 //    "camera": null | {"width": W, "height": H, "fx": .., "fy": .., "cx": .., "cy": ..,
 //                      "R": [[..], [..], [..]], "t": [..]},          (cameras/camera_json.h conventions)
-//    "lights": [{"name": "IMG_0001.jpg", "kind": "training photo", "sh": [[R, G, B] x 9]}, ...],
+//    "lights": [{"name": "IMG_0001.jpg", "kind": "training photo", "sh": [[R, G, B] x 9],
+//                "sky_residual": [[R, G, B] x 25]}, ...],     (sky_residual only where the light has one)
 //    "initial_light": 0, "sky_background": bool, "sky_horizon": null | {..},
 //    "side_rule": null | {"up": [x, y, z], "grazing_degrees": d}}   (shading/surfel_side.h; null: official)
 // Lights in order: those given with --light, then every training photo's learned lighting (embedding
 // order), then "uniform" (constant radiance with irradiance 1 everywhere, for inspecting albedo and
-// geometry). SH are radiance L_lm in the world frame (shading/sh.h order). up, e1, e2 form the right-handed
-// orbit frame of cameras/orbit.h (azimuth a = cos a e1 + sin a e2). centre is the per-axis median of the
-// surfel positions, radius the 90th percentile of their distance to it (robust to stray surfels).
+// geometry). A training photo's light of a run with sky residuals, and an SH file with "#sky" rows, carry
+// the sky's residual (degree 4, shading/sh_degree4.h order): the sky is drawn from light + residual
+// (shading/sky_colour.h), never the shading. SH are radiance L_lm in the world frame (shading/sh.h order).
+// up, e1, e2 form the right-handed orbit frame of cameras/orbit.h (azimuth a = cos a e1 + sin a e2). centre
+// is the per-axis median of the surfel positions, radius the 90th percentile of their distance to it (robust
+// to stray surfels).
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,6 +27,7 @@
 #include "lumigauss/model/trained_run.h"
 #include "lumigauss/relight/light_source.h"
 #include "lumigauss/shading/sh.h"
+#include "lumigauss/shading/sh_degree4.h"
 
 namespace lumigauss::view {
 
@@ -30,6 +35,7 @@ struct ViewerLight {
     std::string name;
     std::string kind;  // light_kind_name(), or "uniform"
     ShCoeffs<double> sh;
+    std::optional<Sh4Coeffs<float>> sky_residual;  // drawn in the sky only
 };
 
 struct ViewerScene {
