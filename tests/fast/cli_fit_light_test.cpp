@@ -146,11 +146,12 @@ TEST(CliFitLight, TheLightFileDrawsThePhotosSky) {
     for (std::string line; std::getline(lines, line);)
         if (line.rfind("#sky", 0) != 0) bare_file << line << "\n";
     bare_file.close();
-    const auto render = [&](const std::string& light, const std::string& name) {
+    const auto render = [&](const std::string& light, const std::string& name,
+                            const std::string& extra = "") {
         const CommandResult r =
             run_lumigauss("render " + shell_quoted(tiny.run) + " --scene " + shell_quoted(tiny.scene) +
                               " --view test_0000.png --outputs shadowed,alpha --background sky -q --light " +
-                              shell_quoted(light) + " -o " + shell_quoted(tmp / name),
+                              shell_quoted(light) + " -o " + shell_quoted(tmp / name) + extra,
                           tmp);
         EXPECT_EQ(r.exit_code, 0) << r.output;
         return std::pair{read_image(tmp / name + "/test_0000_shadowed.png"),
@@ -158,21 +159,25 @@ TEST(CliFitLight, TheLightFileDrawsThePhotosSky) {
     };
     const auto [with_sky, alpha] = render(out, "with");
     const Image without_sky = render(bare, "bare").first, fitted = read_image(fit_png);
+    // A turned light turns its residual with it (it was dropped before): a full turn draws the same sky.
+    const Image turned = render(out, "turned", " --rotate 360").first;
     ASSERT_EQ(fitted.width, with_sky.width);
     int empty = 0;
-    double with_err = 0, without_err = 0;
+    double with_err = 0, without_err = 0, turned_err = 0;
     for (int y = 0; y < alpha.height; ++y)
         for (int x = 0; x < alpha.width; ++x) {
             if (alpha.at(x, y, 0) != 0.0f) continue;
             ++empty;
             for (int c = 0; c < 3; ++c) {
                 with_err = std::max(with_err, double(std::abs(with_sky.at(x, y, c) - fitted.at(x, y, c))));
+                turned_err = std::max(turned_err, double(std::abs(turned.at(x, y, c) - fitted.at(x, y, c))));
                 without_err =
                     std::max(without_err, double(std::abs(without_sky.at(x, y, c) - fitted.at(x, y, c))));
             }
         }
     ASSERT_GT(empty, 20) << "no empty pixel to see the sky in";
     EXPECT_LE(with_err, 1.5 / 255);
+    EXPECT_LE(turned_err, 2.5 / 255);
     EXPECT_GT(without_err, 5.0 / 255);
 }
 
