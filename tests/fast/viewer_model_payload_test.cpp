@@ -167,6 +167,12 @@ TEST(ViewSceneInfo, LightsCarryTheirSkyResiduals) {
     EXPECT_EQ(j["lights"][3]["sky_residual"][24][1].get<double>(), -0.25);
     EXPECT_EQ(j["lights"][2]["sky_residual"][24][1].get<double>(), 0.0);  // p0.jpg's: all zero
     EXPECT_FALSE(j["lights"][4].contains("sky_residual"));                // uniform
+    // A training photo named with --light brings its residual too (resolve_light).
+    const ResolvedLight named = resolve_light("photo:p1.jpg", run, PanoramaOptions{});
+    const nlohmann::json k =
+        nlohmann::json::parse(scene_json(describe_scene(run, {named}, parse_up_axis("-y"), cam)));
+    ASSERT_EQ(k["lights"][0]["sky_residual"].size(), 25u);
+    EXPECT_EQ(k["lights"][0]["sky_residual"][24][1].get<double>(), -0.25);
     run.sky_residuals = SkyResiduals();
     const nlohmann::json bare =
         nlohmann::json::parse(scene_json(describe_scene(run, {}, parse_up_axis("-y"), cam)));

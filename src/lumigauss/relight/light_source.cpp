@@ -55,6 +55,7 @@ ResolvedLight photo_light(const TrainedRun& run, int index) {
     light.photo_index = index;
     light.source = run.image_names[std::size_t(index)];
     light.sh = run.learned_sh(index);
+    if (index < run.sky_residuals.num_images()) light.sky_residual = run.sky_residuals.get(index);
     return light;
 }
 

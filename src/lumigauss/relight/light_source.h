@@ -40,7 +40,8 @@ struct ResolvedLight {
     bool boosted = false;  // the fake HDR boost changed some pixel
     ShCoeffs<double> sh;
     Image panorama;  // a panorama light's pixels as used (boosted), for drawing its sky; else empty
-    std::optional<Sh4Coeffs<float>> sky_residual;  // an SH file's "#sky" rows, for drawing its sky
+    // For drawing its sky: a training photo's residual (a run with sky.lgsky), an SH file's "#sky" rows.
+    std::optional<Sh4Coeffs<float>> sky_residual;
 };
 
 // True for the extensions read as LDR panoramas (.png, .jpg, .jpeg; case-insensitive).

@@ -133,14 +133,10 @@ RelightCameras relight_cameras(const RelightJob& job, const TrainedRun& run) {
 
 namespace {
 
-// The sky residual a light brings: a training photo's (when the run learned them) or the one a fitted SH
-// file carries, turned about `up` with the light (the whole sky turns, as rotate_about_up turns the light).
-std::optional<Sh4Coeffs<float>> light_sky_residual(const ResolvedLight& light, const TrainedRun& run,
-                                                   Vec3d up, double degrees) {
+// The sky residual a light brings (a training photo's, an SH file's; resolve_light), turned about `up` with
+// the light (the whole sky turns, as rotate_about_up turns the light).
+std::optional<Sh4Coeffs<float>> light_sky_residual(const ResolvedLight& light, Vec3d up, double degrees) {
     std::optional<Sh4Coeffs<float>> residual = light.sky_residual;
-    if (light.kind == LightKind::Photo && light.photo_index >= 0 &&
-        light.photo_index < run.sky_residuals.num_images())
-        residual = run.sky_residuals.get(light.photo_index);
     if (residual && degrees != 0)
         residual = rotate_sh4(*residual, rotation_about_axis(up, degrees * std::numbers::pi / 180.0));
     return residual;
@@ -154,7 +150,7 @@ Image frame_sky(const Camera& camera, const RelightSummary& summary, const Train
         return panorama_sky_image(
             camera, {&light.panorama, frame, Vec3d{1, 1, 1} * summary.light_factor, summary.up, degrees, {}});
     // The horizon is about the frame the model was trained in, so a turned light keeps it.
-    std::optional<Sh4Coeffs<float>> residual = light_sky_residual(light, run, summary.up, degrees);
+    std::optional<Sh4Coeffs<float>> residual = light_sky_residual(light, summary.up, degrees);
     if (!residual) return sky_image(camera, env, nullptr, run.sky_horizon);
     for (Vec3f& c : residual->c) c = float(summary.light_factor) * c;
     return sky_image(camera, env, &*residual, run.sky_horizon);
