@@ -212,6 +212,9 @@ struct Trainer::ViewMasks {
     std::vector<float> sky;          // pixels whose photo shows the sky (eroded sky mask); empty: no sky mask
     std::vector<float> regularizer;  // the normal/distortion losses' mask
     std::vector<Vec3f> unseen_sky;   // the sky hemisphere prior's directions: those the camera does not see
+    // The prior's target when the photo has a sky mask (fixed for the run; without one it follows the
+    // background-matched pixels of each iteration). Empty: too few sky pixels, no prior.
+    std::optional<Vec3f> masked_sky_target;
 };
 
 struct Trainer::Scratch {
@@ -315,6 +318,8 @@ void Trainer::prepare_view_masks() {
                                                   view.camera);
         if (!view.sky.pixels.empty() && c.use_sky_masks) {
             m.sky = eroded_mask(view.sky, c.sky_mask_erosion);
+            if (c.lambda_sky_hemisphere > 0)
+                m.masked_sky_target = mean_sky_radiance(view.rgb.pixels, m.sky, kSkyHemisphereMinPixels);
             if (c.sky_free_regularizers)
                 for (std::size_t p = 0; p < pixels; ++p)
                     m.regularizer[p] *= 1.0f - std::min(1.0f, view.sky.pixels[p] * 2.0f);
@@ -542,12 +547,9 @@ void Trainer::render_step(std::int64_t it, Stage stage, StepReport& report) {
             report.total += c.lambda_sky_residual * penalty;
             if (c.lambda_sky_hemisphere > 0) {
                 // The sky the photo shows: its sky mask, else what the sky background already explains.
-                const std::span<const float> seen =
-                    !masks.sky.empty()
-                        ? std::span<const float>(masks.sky)
-                        : (match_background ? std::span<const float>(s.matched) : std::span<const float>());
-                const std::optional<Vec3f> sky_target =
-                    seen.empty() ? std::nullopt : mean_sky_radiance(target, seen, kSkyHemisphereMinPixels);
+                std::optional<Vec3f> sky_target = masks.masked_sky_target;
+                if (masks.sky.empty() && match_background)
+                    sky_target = mean_sky_radiance(target, s.matched, kSkyHemisphereMinPixels);
                 if (sky_target) {
                     report.sky_hemisphere = sky_hemisphere_prior(masks.unseen_sky, clean, sky_residual,
                                                                  *sky_target, c.lambda_sky_hemisphere, g_res);
