@@ -6,7 +6,7 @@
 #   bench/plaza.sh [--scene DIR] [--runs DIR] [--build DIR] [--rows LIST] [--ablations] [--paper-ablations]
 #                  [-- TRAIN ARGS]
 #
-# Rows (--rows, comma-separated; default "default,paper,fast"):
+# Rows (--rows, comma-separated; default "default,paper,fast"; any ablation row below can be named too):
 #   default        the default preset (40k iterations, sky and floater handling)
 #   paper          the official LumiGauss (40k)
 #   fast           the fast variant of the default preset (3k)
@@ -69,34 +69,44 @@ runs="${runs:-runs/$(basename "$scene")}"
 bin="$build/lumigauss"
 [[ -x "$bin" ]] || { echo "bench/plaza.sh: $bin not built (run scripts/setup.sh, or pass --build)" >&2; exit 2; }
 
+# The fast preset with one improvement of the default preset switched off (issue #25); empty for other names.
+ablation_settings() {
+    case "$1" in
+        fast-no-point-normals) echo "--preset fast --set init_normals_from_points=false" ;;
+        fast-no-sky) echo "--preset fast --set sky_background=false" ;;
+        fast-no-sky-alpha) echo "--preset fast --set lambda_sky_alpha=0" ;;
+        fast-no-sky-free-reg) echo "--preset fast --set sky_free_regularizers=false" ;;
+        fast-no-prune-end) echo "--preset fast --set prune_until_end=false" ;;
+        fast-no-empty-prune) echo "--preset fast --set empty_space_prune_share=0" ;;
+        fast-no-low-contribution) echo "--preset fast --set min_contribution_pixels=0" ;;
+        fast-no-traced-shadows) echo "--preset fast --set geometric_transfer_every=0" ;;
+        fast-no-ground-seeds) echo "--preset fast --set ground_seeds=false" ;;
+        fast-no-ground) echo "--preset fast --set ground_backdrop=false" ;;
+        fast-no-grazing-side) echo "--preset fast --set grazing_side_degrees=0" ;;
+        fast-sky-pins-light) echo "--preset fast --set sky_pins_light=true --set sky_residual=false --set lambda_ground_light=0 --set lambda_sky_hemisphere=0" ;;
+        fast-no-ground-light) echo "--preset fast --set lambda_ground_light=0" ;;
+        fast-no-sky-hemisphere) echo "--preset fast --set lambda_sky_hemisphere=0" ;;
+        fast-no-horizon) echo "--preset fast --set sky_horizon_fade=0" ;;
+        fast-no-sky-masks) echo "--preset fast --set use_sky_masks=false" ;;
+        fast-no-sky-masks-no-bg-alpha) echo "--preset fast --set use_sky_masks=false --set lambda_background_alpha=0" ;;
+    esac
+}
+ablation_names=(fast-no-point-normals fast-no-sky fast-no-sky-alpha fast-no-sky-free-reg fast-no-prune-end fast-no-empty-prune fast-no-low-contribution fast-no-traced-shadows fast-no-ground-seeds fast-no-ground fast-no-grazing-side fast-sky-pins-light fast-no-ground-light fast-no-sky-hemisphere fast-no-horizon fast-no-sky-masks fast-no-sky-masks-no-bg-alpha)
+
 declare -a names=() settings=()
 add_row() { names+=("$1"); settings+=("$2"); }
 IFS=',' read -r -a wanted <<< "$rows"
 for row in "${wanted[@]}"; do
     case "$row" in
         default|paper|fast|paper-fast) add_row "$row" "--preset $row" ;;
-        *) echo "bench/plaza.sh: unknown row '$row' (default, paper, fast, paper-fast)" >&2; exit 2 ;;
+        *) [[ -n "$(ablation_settings "$row")" ]] ||
+               { echo "bench/plaza.sh: unknown row '$row' (default, paper, fast, paper-fast or an ablation)" >&2
+                 exit 2; }
+           add_row "$row" "$(ablation_settings "$row")" ;;
     esac
 done
 if [[ $ablations == 1 ]]; then
-    add_row fast-no-point-normals "--preset fast --set init_normals_from_points=false"
-    add_row fast-no-sky "--preset fast --set sky_background=false"
-    add_row fast-no-sky-alpha "--preset fast --set lambda_sky_alpha=0"
-    add_row fast-no-sky-free-reg "--preset fast --set sky_free_regularizers=false"
-    add_row fast-no-prune-end "--preset fast --set prune_until_end=false"
-    add_row fast-no-empty-prune "--preset fast --set empty_space_prune_share=0"
-    add_row fast-no-low-contribution "--preset fast --set min_contribution_pixels=0"
-    add_row fast-no-traced-shadows "--preset fast --set geometric_transfer_every=0"
-    add_row fast-no-ground-seeds "--preset fast --set ground_seeds=false"
-    add_row fast-no-ground "--preset fast --set ground_backdrop=false"
-    add_row fast-no-grazing-side "--preset fast --set grazing_side_degrees=0"
-    add_row fast-sky-pins-light \
-        "--preset fast --set sky_pins_light=true --set sky_residual=false --set lambda_ground_light=0 --set lambda_sky_hemisphere=0"
-    add_row fast-no-ground-light "--preset fast --set lambda_ground_light=0"
-    add_row fast-no-sky-hemisphere "--preset fast --set lambda_sky_hemisphere=0"
-    add_row fast-no-horizon "--preset fast --set sky_horizon_fade=0"
-    add_row fast-no-sky-masks "--preset fast --set use_sky_masks=false"
-    add_row fast-no-sky-masks-no-bg-alpha "--preset fast --set use_sky_masks=false --set lambda_background_alpha=0"
+    for name in "${ablation_names[@]}"; do add_row "$name" "$(ablation_settings "$name")"; done
 fi
 if [[ $paper_ablations == 1 ]]; then
     add_row no_stage1 "--preset paper --set warmup=1 --set start_shadowed=501"
