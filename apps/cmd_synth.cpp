@@ -17,7 +17,7 @@ struct SynthFlags {
     int width = 0, height = 0, train = 0, test = 0, spp_side = 0, points = 0, gt_surfels = 0;
     unsigned long long seed = 1;
     double transients = 0;
-    bool force = false, verbose = false, object_masks = false;
+    bool force = false, verbose = false, quiet = false, object_masks = false;
     CLI::Option *o_width, *o_height, *o_train, *o_test, *o_transients, *o_spp, *o_points, *o_gt_surfels;
 };
 
@@ -43,6 +43,7 @@ synth::SynthOptions to_options(const SynthFlags& f) {
 void run_synth(const SynthFlags& f) {
     const synth::SynthOptions o = to_options(f);
     const synth::SynthSummary s = synth::generate_synthetic_scene(o);
+    if (f.quiet) return;
     std::printf(
         "synth: wrote %s: landmark %s, %dx%d, %d train (%d with pedestrians) + %d test photos, %d lighting "
         "conditions, %d points3D, %d ground-truth surfels in %.2f s\n",
@@ -92,7 +93,8 @@ void register_synth(CLI::App& app) {
         "Write masks/ as foreground masks of the landmark (255 on it, 0 on the ground, people and sky), "
         "as collections of one object come (train with --set mask_mode=object)");
     cmd->add_flag("--force", f->force, "Replace the dataset files of an existing output folder");
-    cmd->add_flag("-v,--verbose", f->verbose, "Print each photo as it is rendered");
+    CLI::Option* verbose = cmd->add_flag("-v,--verbose", f->verbose, "Print each photo as it is rendered");
+    cmd->add_flag("-q,--quiet", f->quiet, "Print nothing (errors still go to stderr)")->excludes(verbose);
     cmd->callback([f] { run_synth(*f); });
 }
 

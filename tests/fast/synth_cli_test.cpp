@@ -41,6 +41,18 @@ TEST(SynthCli, WritesTheTinyPresetWithOverrides) {
     EXPECT_EQ(again.exit_code, 1) << again.output;
     EXPECT_NE(again.output.find("--force"), std::string::npos) << again.output;
 
+    // -q, as every command takes it: nothing printed, the dataset written; with -v it is an error.
+    const CommandResult quiet = run_lumigauss(
+        "synth --preset tiny --train 2 --test 0 --width 16 --height 12 -q -o '" + tmp.sub("quiet") + "'",
+        tmp);
+    ASSERT_EQ(quiet.exit_code, 0) << quiet.output;
+    EXPECT_EQ(quiet.output, "");
+    EXPECT_EQ(load_dataset(tmp.sub("quiet"), DatasetOptions{}).views.size(), 2u);
+    const CommandResult loud_and_quiet =
+        run_lumigauss("synth --preset tiny -q -v -o '" + tmp.sub("both") + "'", tmp);
+    EXPECT_NE(loud_and_quiet.exit_code, 0);
+    EXPECT_NE(loud_and_quiet.output.find("excludes"), std::string::npos) << loud_and_quiet.output;
+
     const CommandResult bad =
         run_lumigauss("synth --preset tiny --transients 2 -o '" + tmp.sub("x") + "'", tmp);
     EXPECT_NE(bad.exit_code, 0);
