@@ -440,7 +440,7 @@ TrainConfig train_preset(std::string_view name) {
     // (train/sky_hemisphere_prior.h): relit from new viewpoints under the training photos' lights, plaza's
     // test_0009 showed 8 of 60 skies more than a quarter black, now 2 (bench/RESULTS.md, session 40; demo
     // plaza 2 -> 0 of 40); shadowed gt-env -0.12 to +0.09 dB on three scenes at the fast schedule, and on
-    // plaza's 40k schedule 19.07 -> 19.34 dB (seed 0; sessions 40-41).
+    // plaza's 40k schedule 19.07 -> 19.34 and 19.16 -> 19.13 dB (seeds 0, 1; sessions 40-41).
     if (name == "fast" || name == "default") config.lambda_sky_hemisphere = 1.0;
     // The sky's pixels shape the sky's own residual, not the light (a degree-2 light cannot draw a sky with a
     // sun: pinned to the sky, the lights lost their direction), and the light from below is pulled towards
