@@ -84,6 +84,14 @@ void run_gt_env(const EvalOptions& o) {
                 "lights %.2f x as directional as the true ones, %.0f deg off (medians)\n",
                 result.light.scale, result.light.per_photo.size(), result.light.relative_residual,
                 result.light.median_direction_strength, result.light.median_direction_error_deg);
+        if (const auto& ref = result.light_reference)
+            std::printf(
+                "  what the photos tell of their lights: %d of 9 directions seen (median), %.0f %% of the "
+                "true "
+                "lights unseen; seen-part residual %.3f (learned) / %.3f (reference with the true albedo and "
+                "normals, whole light %.3f)\n",
+                ref->median_seen, 100 * ref->unseen_share, ref->learned_seen_residual,
+                ref->reference_seen_residual, ref->reference_residual);
         for (const GtEnvImageResult& im : result.images)
             std::printf("  %-24s %-14s shadowed PSNR %6.2f SSIM %.4f | unshadowed PSNR %6.2f SSIM %.4f\n",
                         im.name.c_str(), im.condition.c_str(), im.shadowed.psnr, im.shadowed.ssim,
@@ -126,7 +134,8 @@ void run_gt_env(const EvalOptions& o) {
         "albedo_psnr=%.4f normal_mean_deg=%.3f normal_median_deg=%.3f render_ms=%.2f sky_alpha=%.4f "
         "light_residual=%.4f empty=%.4f covered_psnr=%.4f scaled_psnr=%.4f sky_mean_alpha=%.4f "
         "light_direction=%.4f light_direction_error_deg=%.2f up_psnr=%.4f other_psnr=%.4f up_gain=%.4f "
-        "other_gain=%.4f\n",
+        "other_gain=%.4f light_seen_residual=%.4f light_reference_residual=%.4f "
+        "light_reference_seen_residual=%.4f\n",
         result.mean_shadowed.psnr, result.mean_shadowed.ssim, result.mean_unshadowed.psnr,
         result.mean_unshadowed.ssim, result.has_albedo ? result.mean_albedo.psnr : nan,
         result.has_normal ? result.mean_normal.mean_deg : nan,
@@ -138,7 +147,10 @@ void run_gt_env(const EvalOptions& o) {
         result.light.median_direction_error_deg, result.has_normal ? result.surfaces.up.psnr() : nan,
         result.has_normal ? result.surfaces.other.psnr() : nan,
         result.has_normal ? mean_gain(result.surfaces.up) : nan,
-        result.has_normal ? mean_gain(result.surfaces.other) : nan);
+        result.has_normal ? mean_gain(result.surfaces.other) : nan,
+        result.light_reference ? result.light_reference->learned_seen_residual : nan,
+        result.light_reference ? result.light_reference->reference_residual : nan,
+        result.light_reference ? result.light_reference->reference_seen_residual : nan);
     std::printf("eval: wrote %s/metrics.json and %s/report.md (%.1f s)\n", o.out.c_str(), o.out.c_str(), s);
 }
 

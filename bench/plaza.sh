@@ -152,25 +152,30 @@ done
 
 echo
 echo "gt-env on $scene (test views: novel views under novel lights; light scale fitted on training photos only)"
-printf '%-30s %8s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s %7s %7s %8s %8s %8s %8s %8s %8s\n' run "shad.PSNR" \
+printf '%-30s %8s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s %7s %7s %7s %8s %8s %8s %8s %8s %8s\n' run "shad.PSNR" \
        "shad.SSIM" "unsh.PSNR" "unsh.SSIM" "alb.PSNR" "norm.mean" "norm.med" "trainmed" "sky%" "skyveil" "lightres" \
-       "lightdir" "empty%" "cov.PSNR" "img.PSNR" "walls" "wallgain" "train min" "surfels"
+       "seenres" "lightdir" "empty%" "cov.PSNR" "img.PSNR" "walls" "wallgain" "train min" "surfels"
+reference=""
 while read -r name seconds surfels train_median rest; do
     declare -A m=()
     for kv in $rest; do m[${kv%%=*}]=${kv#*=}; done
-    printf '%-30s %8.2f %8.4f %8.2f %8.4f %8.2f %8.2f %8.2f %8.2f %7.2f %7.4f %7.3f %7.2f %7.2f %8.2f %8.2f %8.2f %8.3f %8.1f %8s\n' "$name" \
+    printf '%-30s %8.2f %8.4f %8.2f %8.4f %8.2f %8.2f %8.2f %8.2f %7.2f %7.4f %7.3f %7.3f %7.2f %7.2f %8.2f %8.2f %8.2f %8.3f %8.1f %8s\n' "$name" \
            "${m[shadowed_psnr]}" "${m[shadowed_ssim]}" "${m[unshadowed_psnr]}" "${m[unshadowed_ssim]}" \
            "${m[albedo_psnr]}" "${m[normal_mean_deg]}" "${m[normal_median_deg]}" "$train_median" \
            "$(awk -v s="${m[sky_alpha]}" 'BEGIN { print 100 * s }')" "${m[sky_mean_alpha]:-nan}" "${m[light_residual]}" \
-           "${m[light_direction]:-nan}" "$(awk -v s="${m[empty]}" 'BEGIN { print 100 * s }')" "${m[covered_psnr]}" \
+           "${m[light_seen_residual]:-nan}" "${m[light_direction]:-nan}" "$(awk -v s="${m[empty]}" 'BEGIN { print 100 * s }')" "${m[covered_psnr]}" \
            "${m[scaled_psnr]:-nan}" "${m[other_psnr]:-nan}" "${m[other_gain]:-nan}" \
            "$(awk -v s="$seconds" 'BEGIN { print s / 60 }')" "$surfels"
+    reference="${m[light_reference_residual]:-nan} ${m[light_reference_seen_residual]:-nan}"
     unset m
 done < "$summary"
 echo "(norm.mean/norm.med: normal error on the test views, degrees; trainmed: median normal error on the"
 echo " training views; sky%: test-view sky pixels (gt/mask = 0) where the render's alpha > 0.5; skyveil: the"
 echo " mean alpha over those sky pixels (faint surfels in front of the cameras that never reach 0.5); lightres:"
 echo " relative residual of the light-scale fit, 0 when every learned light is one common scale of the true one;"
+echo " seenres: the same on the part of each light its photo's normals can tell apart (the rest is left to priors);"
+echo "  lights fitted to the photos' shading with the TRUE albedo and normals reach (lightres seenres):" \
+     "${reference:-nan nan};"
 echo " lightdir: how directional the learned lights are, median |band 1|/DC over the true one's (1 = as the truth);"
 echo " empty%: evaluated test pixels the model leaves empty (alpha <= 0.5); cov.PSNR: shadowed PSNR over the others;"
 echo " img.PSNR: shadowed PSNR with the light scale fitted per channel on the training images instead;"

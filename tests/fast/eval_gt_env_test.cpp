@@ -211,6 +211,17 @@ TEST(EvalGtEnv, GroundTruthSurfelsScoreWell) {
     const GtEnvResult r = evaluate_gt_env(run, scene, load_gt_scene_meta(root));
     EXPECT_NEAR(r.light.scale, 0.6, 1e-8);
     EXPECT_NEAR(r.light.relative_residual, 0.0, 1e-6);
+    // The learned lights are the true ones (up to k and exposure): no residual on the part the photos see
+    // either. The reference lights, fitted to the photos' shading, see only part of each light.
+    ASSERT_TRUE(r.light_reference.has_value());
+    EXPECT_EQ(r.light_reference->photos, int(scene.split(Split::Train).size()));
+    EXPECT_NEAR(r.light_reference->learned_seen_residual, 0.0, 1e-6);
+    EXPECT_GE(r.light_reference->min_seen, 1);
+    EXPECT_LE(r.light_reference->median_seen, 9);
+    EXPECT_GE(r.light_reference->unseen_share, 0.0);
+    EXPECT_LT(r.light_reference->unseen_share, 1.0);
+    EXPECT_GT(r.light_reference->reference_residual, 0.0);
+    EXPECT_LT(r.light_reference->reference_seen_residual, 1.0);
     ASSERT_EQ(r.images.size(), scene.split(Split::Test).size());
     ASSERT_TRUE(r.gt_mask);
     ASSERT_TRUE(r.has_albedo);
@@ -250,6 +261,7 @@ TEST(EvalGtEnv, GroundTruthSurfelsScoreWell) {
     EXPECT_EQ(j["images"].size(), r.images.size());
     EXPECT_TRUE(j["images"][0]["shadowed"].contains("ssim"));
     EXPECT_TRUE(j["mean"]["normal"].contains("median_deg"));
+    EXPECT_TRUE(j["light_scale"]["reference"].contains("learned_seen_residual"));
     const Image sheet = gt_env_contact_sheet(r.images[0]);
     EXPECT_EQ(sheet.width, 6 * scene.views[0].camera.width + 10);
     EXPECT_EQ(sheet.height, 2 * scene.views[0].camera.height + 2);
@@ -276,6 +288,12 @@ TEST(EvalGtEnv, MetricsAreInvariantUnderTheAlbedoLightGauge) {
         EXPECT_NEAR(rb.albedo_gamma_scale[ch] * c / ra.albedo_gamma_scale[ch], 1.0, 1e-4);
         EXPECT_NEAR(rb.albedo_scale[ch] * std::pow(c, 2.2) / ra.albedo_scale[ch], 1.0, 1e-4);
     }
+    // The reference comes from the scene alone; the seen residual of the learned lights absorbs c like k.
+    ASSERT_TRUE(ra.light_reference && rb.light_reference);
+    EXPECT_EQ(ra.light_reference->reference_residual, rb.light_reference->reference_residual);
+    EXPECT_NEAR(ra.light_reference->learned_seen_residual, rb.light_reference->learned_seen_residual, 1e-6);
+    opt.light_reference = false;
+    EXPECT_FALSE(evaluate_gt_env(oracle_run(root, 1.0), scene, meta, opt).light_reference.has_value());
 }
 
 // The image-space light scale (header, step 8) follows the per-channel colour gauge that one scalar k cannot:

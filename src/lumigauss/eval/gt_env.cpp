@@ -353,6 +353,7 @@ GtEnvResult evaluate_gt_env(const RelightableRun& run, const Dataset& scene, con
     if (options.views != Split::Train)
         for (const View* v : views) test_names.push_back(v->name);
     result.light = fit_run_light_scale(run, meta, test_names);
+    if (options.light_reference) result.light_reference = light_reference(run, scene, meta, test_names);
     if (options.image_light_scale)
         if (const auto k = fit_image_light_scale(run, scene, meta, test_names, options.backend)) {
             result.image_scaled = true;

@@ -50,12 +50,18 @@
 //    that would take the render onto the photo there. Gains near 1 on one and not on the other say that the
 //    model's albedo of one kind of surface is off against the other's (on plaza the walls come out a third
 //    too dark: bench/RESULTS.md, session 35), which no light scale can fix.
+// 10. What the photos can tell about their lights (when the training photos have gt/albedo and gt/normal;
+//    light_reference.h): the residual of step 1 on the part of each light its photo's normals see, and the
+//    residual of lights fitted to the photos' shading with the true albedo and normals (a reference for
+//    step 1's residual, as 21.26 dB is for the PSNR on plaza).
 // Ground-truth images are area-resampled to the evaluated resolution (-r) like the photos.
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "lumigauss/eval/gt_scene.h"
+#include "lumigauss/eval/light_reference.h"
 #include "lumigauss/eval/light_scale.h"
 #include "lumigauss/eval/relightable_run.h"
 #include "lumigauss/eval/sheet_panels.h"
@@ -114,6 +120,9 @@ struct GtEnvImageResult {
 struct GtEnvResult {
     Split views = Split::Test;  // which photos were scored (GtEnvOptions::views)
     LightScaleFit light;
+    // What the training photos can tell about their lights (light_reference.h); nothing without gt/albedo
+    // and gt/normal or when GtEnvOptions::light_reference is off.
+    std::optional<LightReference> light_reference;
     bool image_scaled = false;  // step 8 ran (GtEnvOptions::image_light_scale) and found usable pixels
     std::array<double, 3> image_light_scale{1, 1, 1};  // its k per channel
     int downscale = 1;
@@ -148,6 +157,8 @@ struct GtEnvOptions {
     RasterBackend backend = RasterBackend::Cpu;
     // Step 8: also fit the light scale per channel on the training images and score the test views under it.
     bool image_light_scale = true;
+    // Also fit the reference lights with the true albedo and normals of the training photos.
+    bool light_reference = true;
 };
 
 // Runs the protocol on every test view of `scene` (loaded at the resolution to evaluate). Throws Error

@@ -189,6 +189,20 @@ nlohmann::ordered_json gt_env_metrics_json(const GtEnvResult& r, const ReportSou
          "mean of the channels) and the angle between their band-1 vectors; medians over the photos whose "
          "true light has a direction (|band 1| >= 0.05 DC)"},
         {"per_photo_direction", per_photo_direction}};
+    if (const auto& ref = r.light_reference)
+        j["light_scale"]["reference"] = {
+            {"method",
+             "per training photo with gt/albedo and gt/normal: the light directions its normals tell apart "
+             "(eigenvalues of the irradiance Gram >= 1e-3 of the largest) and the least-squares light of "
+             "radiance = true albedo / pi * E(true normal) on them (cast shadows dropped); residuals as "
+             "relative_residual"},
+            {"photos", ref->photos},
+            {"seen_directions_min", ref->min_seen},
+            {"seen_directions_median", ref->median_seen},
+            {"unseen_share", number(ref->unseen_share)},
+            {"learned_seen_residual", number(ref->learned_seen_residual)},
+            {"reference_residual", number(ref->reference_residual)},
+            {"reference_seen_residual", number(ref->reference_seen_residual)}};
     j["test_exposure"] = "each test photo's meta.json exposure (its camera setting, not lighting) is applied";
     j["mask"] = r.gt_mask ? "gt/mask eroded 5x5 once, full coverage only, times the scene mask"
                           : "scene mask eroded 5x5 once, full coverage only (no gt/mask)";
@@ -297,6 +311,18 @@ std::string gt_env_report_markdown(const GtEnvResult& r, const ReportSources& sr
             fmt("%.2f", r.light.median_direction_strength) +
             " x the true band-1 strength (|band 1| / DC; 1 = as directional as the truth), their direction " +
             fmt("%.0f", r.light.median_direction_error_deg) + " deg from the true one.\n";
+    if (const auto& ref = r.light_reference)
+        s += "- What the photos can tell about their lights (" + std::to_string(ref->photos) +
+             " training photos with true albedo and normals): their normals tell apart " +
+             std::to_string(ref->median_seen) + " of a degree-2 light's 9 directions (median; fewest " +
+             std::to_string(ref->min_seen) + "), and " + fmt("%.0f", 100 * ref->unseen_share) +
+             " % of the true lights lie in the rest. On the part they see, the learned lights' residual is " +
+             fmt("%.3f", ref->learned_seen_residual) +
+             ". Lights fitted to the photos' shading with the TRUE albedo and normals (cast shadows dropped) "
+             "reach " +
+             fmt("%.3f", ref->reference_residual) + " (whole) and " +
+             fmt("%.3f", ref->reference_seen_residual) +
+             " (seen part): a reference for the residual above.\n";
     if (r.sky_behind) {
         s += "- The run was trained with its sky behind the surfels: renders are drawn over the condition's "
              "panorama (`env/COND.exr`; its SH where there is none) times `k * exposure`";
