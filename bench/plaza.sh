@@ -69,29 +69,33 @@ runs="${runs:-runs/$(basename "$scene")}"
 bin="$build/lumigauss"
 [[ -x "$bin" ]] || { echo "bench/plaza.sh: $bin not built (run scripts/setup.sh, or pass --build)" >&2; exit 2; }
 
-# The fast preset with one improvement of the default preset switched off (issue #25); empty for other names.
+# The fast preset with one improvement of the default preset switched off (issue #25): name, then its
+# settings, in the order --ablations trains them.
+ablations_list=(
+    fast-no-point-normals "--set init_normals_from_points=false"
+    fast-no-sky "--set sky_background=false"
+    fast-no-sky-alpha "--set lambda_sky_alpha=0"
+    fast-no-sky-free-reg "--set sky_free_regularizers=false"
+    fast-no-prune-end "--set prune_until_end=false"
+    fast-no-empty-prune "--set empty_space_prune_share=0"
+    fast-no-low-contribution "--set min_contribution_pixels=0"
+    fast-no-traced-shadows "--set geometric_transfer_every=0"
+    fast-no-ground-seeds "--set ground_seeds=false"
+    fast-no-ground "--set ground_backdrop=false"
+    fast-no-grazing-side "--set grazing_side_degrees=0"
+    fast-sky-pins-light "--set sky_pins_light=true --set sky_residual=false --set lambda_ground_light=0 --set lambda_sky_hemisphere=0"
+    fast-no-ground-light "--set lambda_ground_light=0"
+    fast-no-sky-hemisphere "--set lambda_sky_hemisphere=0"
+    fast-no-horizon "--set sky_horizon_fade=0"
+    fast-no-sky-masks "--set use_sky_masks=false"
+    fast-no-sky-masks-no-bg-alpha "--set use_sky_masks=false --set lambda_background_alpha=0"
+)
+# The train arguments of an ablation row; empty for other names.
 ablation_settings() {
-    case "$1" in
-        fast-no-point-normals) echo "--preset fast --set init_normals_from_points=false" ;;
-        fast-no-sky) echo "--preset fast --set sky_background=false" ;;
-        fast-no-sky-alpha) echo "--preset fast --set lambda_sky_alpha=0" ;;
-        fast-no-sky-free-reg) echo "--preset fast --set sky_free_regularizers=false" ;;
-        fast-no-prune-end) echo "--preset fast --set prune_until_end=false" ;;
-        fast-no-empty-prune) echo "--preset fast --set empty_space_prune_share=0" ;;
-        fast-no-low-contribution) echo "--preset fast --set min_contribution_pixels=0" ;;
-        fast-no-traced-shadows) echo "--preset fast --set geometric_transfer_every=0" ;;
-        fast-no-ground-seeds) echo "--preset fast --set ground_seeds=false" ;;
-        fast-no-ground) echo "--preset fast --set ground_backdrop=false" ;;
-        fast-no-grazing-side) echo "--preset fast --set grazing_side_degrees=0" ;;
-        fast-sky-pins-light) echo "--preset fast --set sky_pins_light=true --set sky_residual=false --set lambda_ground_light=0 --set lambda_sky_hemisphere=0" ;;
-        fast-no-ground-light) echo "--preset fast --set lambda_ground_light=0" ;;
-        fast-no-sky-hemisphere) echo "--preset fast --set lambda_sky_hemisphere=0" ;;
-        fast-no-horizon) echo "--preset fast --set sky_horizon_fade=0" ;;
-        fast-no-sky-masks) echo "--preset fast --set use_sky_masks=false" ;;
-        fast-no-sky-masks-no-bg-alpha) echo "--preset fast --set use_sky_masks=false --set lambda_background_alpha=0" ;;
-    esac
+    for ((i = 0; i < ${#ablations_list[@]}; i += 2)); do
+        [[ "${ablations_list[$i]}" == "$1" ]] && { echo "--preset fast ${ablations_list[$((i + 1))]}"; return; }
+    done
 }
-ablation_names=(fast-no-point-normals fast-no-sky fast-no-sky-alpha fast-no-sky-free-reg fast-no-prune-end fast-no-empty-prune fast-no-low-contribution fast-no-traced-shadows fast-no-ground-seeds fast-no-ground fast-no-grazing-side fast-sky-pins-light fast-no-ground-light fast-no-sky-hemisphere fast-no-horizon fast-no-sky-masks fast-no-sky-masks-no-bg-alpha)
 
 declare -a names=() settings=()
 add_row() { names+=("$1"); settings+=("$2"); }
@@ -106,7 +110,9 @@ for row in "${wanted[@]}"; do
     esac
 done
 if [[ $ablations == 1 ]]; then
-    for name in "${ablation_names[@]}"; do add_row "$name" "$(ablation_settings "$name")"; done
+    for ((i = 0; i < ${#ablations_list[@]}; i += 2)); do
+        add_row "${ablations_list[$i]}" "--preset fast ${ablations_list[$((i + 1))]}"
+    done
 fi
 if [[ $paper_ablations == 1 ]]; then
     add_row no_stage1 "--preset paper --set warmup=1 --set start_shadowed=501"
