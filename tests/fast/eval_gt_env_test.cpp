@@ -471,6 +471,7 @@ TEST(EvalGtEnv, WorksWithoutGroundTruthImages) {
     EXPECT_FALSE(r.gt_mask);
     EXPECT_FALSE(r.has_albedo);
     EXPECT_FALSE(r.has_normal);
+    EXPECT_FALSE(r.light_reference.has_value());  // it needs the true albedo and normals
     for (const GtEnvImageResult& im : r.images) {
         EXPECT_EQ(im.mask_pixels, std::size_t(64 * 48));  // test photos have no transients
         EXPECT_TRUE(std::isfinite(im.shadowed.psnr));
@@ -478,6 +479,7 @@ TEST(EvalGtEnv, WorksWithoutGroundTruthImages) {
     const nlohmann::ordered_json j = gt_env_metrics_json(r, {"run", root});
     EXPECT_FALSE(j.contains("albedo_scale"));
     EXPECT_FALSE(j["images"][0].contains("normal"));
+    EXPECT_FALSE(j["light_scale"].contains("reference"));
     // A missing SH file of a test condition is named.
     const GtSceneMeta meta = load_gt_scene_meta(root);
     const std::string cond = meta.find(load_dataset(root).split(Split::Test)[0]->name)->condition;
