@@ -87,9 +87,8 @@ void run_gt_env(const EvalOptions& o) {
         if (const auto& ref = result.light_reference)
             std::printf(
                 "  what the photos tell of their lights: %d of 9 directions seen (median), %.0f %% of the "
-                "true "
-                "lights unseen; seen-part residual %.3f (learned) / %.3f (reference with the true albedo and "
-                "normals, whole light %.3f)\n",
+                "true lights unseen; seen-part residual %.3f (learned) / %.3f (reference with the true "
+                "albedo and normals, whole light %.3f)\n",
                 ref->median_seen, 100 * ref->unseen_share, ref->learned_seen_residual,
                 ref->reference_seen_residual, ref->reference_residual);
         for (const GtEnvImageResult& im : result.images)

@@ -7,9 +7,8 @@
 // residual of the whole light, gt-env reports:
 // - the learned lights' residual on the part each photo sees (the seen residual), and
 // - the residual of a reference that knows the scene's true albedo and normals (gt/albedo, gt/normal) and
-// fits
-//   each training photo's light to its shading, cast-shadow pixels dropped: about the best a degree-2 light
-//   learned from these photos can reach without knowing the unseen part.
+//   fits each training photo's light to its shading, cast-shadow pixels dropped: about the best a degree-2
+//   light learned from these photos can reach without knowing the unseen part.
 #include <optional>
 #include <string>
 #include <vector>
